@@ -1,0 +1,1 @@
+"""Command groups of the ``more-agent`` CLI, one module each."""

@@ -1,0 +1,1 @@
+"""Evaluation: episode records, the episode runner, metrics, resumable runs and reports."""

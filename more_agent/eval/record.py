@@ -1,0 +1,90 @@
+"""The per-episode record: what one episode did and how it ended.
+
+Written as ``DIR/episode.json`` by ``more-agent run`` and as one line of ``DIR/episodes.jsonl`` by
+``more-agent eval``. Metrics (``more_agent.eval.metrics``) are pure functions of these records.
+"""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field
+
+RECORD_SCHEMA_VERSION = 1
+
+
+class GoalCondition(BaseModel):
+    """One conjunct of the grounded goal option that was closest to being met."""
+
+    model_config = ConfigDict(frozen=True)
+
+    text: str = Field(description="The literal in BDDL form, e.g. '(inside apple.n.01_1 fridge.n.01_1)'.")
+    satisfied: bool = Field(description="Whether the literal held in the final world state.")
+    objects: list[str] = Field(default_factory=list, description="Instance names the literal mentions.")
+
+
+class ActionRecord(BaseModel):
+    """One high-level action (subpolicy call or magic action) and its feedback."""
+
+    model_config = ConfigDict(frozen=True)
+
+    step: int = Field(description="High-level step index, from 0.")
+    name: str = Field(description="Subpolicy or action name, e.g. 'go_to_and_grasp'.")
+    arguments: list[str] = Field(default_factory=list, description="Arguments as given.")
+    ok: bool = Field(description="Whether the action succeeded.")
+    feedback: str = Field(default="", description="Feedback returned to the planner (failure reason if not ok).")
+    low_level_steps: int = Field(default=0, description="Low-level steps (moves, turns) the action took.")
+
+
+class LLMUsage(BaseModel):
+    """LLM traffic of an episode, summed over all calls."""
+
+    calls: int = 0
+    prompt_tokens: int = 0
+    completion_tokens: int = 0
+    cost_usd: float = 0.0
+    cache_hits: int = 0
+
+
+class EpisodeRecord(BaseModel):
+    """Everything one episode produced; the same task, scene and seed give the same record, timings aside."""
+
+    schema_version: int = RECORD_SCHEMA_VERSION
+    task: str = Field(description="BEHAVIOR-1K activity name.")
+    scene: str = Field(description="Scene name, e.g. 'Rs_int'.")
+    seed: int = Field(description="Seed of scene generation and task instantiation.")
+    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr'.")
+    llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
+    description: str = Field(default="", description="Language description the planner received.")
+    success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
+    all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
+    done_called: bool = Field(default=False, description="Whether the planner ended the episode with done().")
+    task_progress: float = Field(default=0.0, description="Share of goal conditions met (TP).")
+    goal_conditions: list[GoalCondition] = Field(default_factory=list)
+    observed_objects: list[str] = Field(
+        default_factory=list, description="Task instance names the robot observed during the episode (for rTP)."
+    )
+    high_level_steps: int = 0
+    low_level_steps: int = 0
+    actions: list[ActionRecord] = Field(default_factory=list)
+    trajectory: list[tuple[float, float]] = Field(
+        default_factory=list, description="Robot base positions (x, y) in metres, world frame, one per pose change."
+    )
+    llm_usage: LLMUsage = Field(default_factory=LLMUsage)
+    timings: dict[str, float] = Field(default_factory=dict, description="Seconds per phase, e.g. 'instantiate'.")
+    error: str | None = Field(default=None, description="None, or why the episode ended abnormally.")
+    traceback: str | None = Field(default=None, description="Python traceback when the episode raised.")
+
+    def key(self) -> tuple[str, str, int, str]:
+        """Identity of the episode within a run: (task, scene, seed, planner)."""
+        return (self.task, self.scene, self.seed, self.planner)
+
+
+class EpisodeSpec(BaseModel):
+    """What to run: one (task, scene, seed, planner, llm) combination; the unit of evaluation work."""
+
+    model_config = ConfigDict(frozen=True)
+
+    task: str = Field(description="BEHAVIOR-1K activity name.")
+    scene: str | None = Field(default=None, description="Scene name; None picks the first scene that suits the task.")
+    seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
+    planner: str = Field(default="oracle", description="Planner name.")
+    llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
