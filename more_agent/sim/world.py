@@ -1,0 +1,294 @@
+"""World state: every object with its pose, containment and articulation, and the robot.
+
+The world is symbolic where the paper's magic actions are (what rests inside / on top of what, what
+is open, what is held) and geometric where sensing and navigation need it (axis-aligned boxes).
+Positions of movable items are derived from their support: an item placed on or in a parent takes
+the first free slot on the parent's top surface or interior floor. Nothing here knows about tasks,
+actions or rendering; they read and change the world through this API.
+"""
+
+from __future__ import annotations
+
+import re
+import string
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from more_agent.sim.scene import STRUCTURAL_CLASSES, Scene
+
+Relation = Literal["inside", "ontop"]
+ObjectKind = Literal["floor", "door", "furniture", "item"]
+
+SLAB_FRACTION = 0.08
+"""Thickness of a container's bottom / top slab as a share of its height (inner items rest on it)."""
+
+SLOT_GAP_M = 0.02
+"""Gap left between neighbouring items on one support."""
+
+
+@dataclass
+class WorldObject:
+    """One object of the world. ``center`` / ``size`` describe its axis-aligned box in metres."""
+
+    name: str
+    category: str
+    kind: ObjectKind
+    center: np.ndarray
+    size: np.ndarray
+    room: str | None = None
+    synset: str | None = None
+    label: str = ""
+    openable: bool = False
+    is_open: bool = False
+    parent: str | None = None
+    relation: Relation | None = None
+    instance_id: int = 0
+
+    @property
+    def movable(self) -> bool:
+        """Items can be grasped and placed; floors, doors and furniture stay put."""
+        return self.kind == "item"
+
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(min corner, max corner) of the box."""
+        half = self.size / 2
+        return self.center - half, self.center + half
+
+    @property
+    def top(self) -> float:
+        return float(self.center[2] + self.size[2] / 2)
+
+    @property
+    def bottom(self) -> float:
+        return float(self.center[2] - self.size[2] / 2)
+
+
+@dataclass
+class RobotState:
+    """The robot base pose (x, y in metres, yaw in radians from +x, counter-clockwise) and its gripper."""
+
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+    held: str | None = None
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array([self.x, self.y])
+
+
+@dataclass
+class World:
+    """The mutable state of one episode's world, built from a static ``Scene``.
+
+    ``version`` increases on every change so that renderers and planners can cache derived data.
+    """
+
+    scene: Scene
+    objects: dict[str, WorldObject] = field(default_factory=dict)
+    robot: RobotState = field(default_factory=RobotState)
+    class_names: list[str] = field(default_factory=lambda: list(STRUCTURAL_CLASSES))
+    version: int = 0
+
+    # -- construction -------------------------------------------------------------------------
+    @classmethod
+    def from_scene(cls, scene: Scene) -> World:
+        """A world holding the scene's floors (one per room), doors and furniture, no items yet."""
+        world = cls(scene=scene)
+        for room in scene.rooms:
+            x0, y0, x1, y1 = room.bounds
+            world.add(WorldObject(
+                name=f"floor_{room.id}", category=room.ground, kind="floor", room=room.id,
+                center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, -0.005]), size=np.array([x1 - x0, y1 - y0, 0.01]),
+            ))
+        for door in scene.doors:
+            x0, y0, x1, y1 = door.bounds()
+            world.add(WorldObject(
+                name=door.id, category="door", kind="door", room=door.rooms[0], synset="door.n.01",
+                center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, door.height / 2]),
+                size=np.array([x1 - x0, y1 - y0, door.height]), openable=True, is_open=door.open,
+            ))
+        for f in scene.furniture:
+            world.add(WorldObject(
+                name=f.id, category=f.category, kind="furniture", room=f.room, synset=f.synset,
+                center=np.array(f.center, dtype=float), size=np.array(f.size, dtype=float),
+                openable=f.openable, is_open=f.open,
+            ))
+        world.assign_labels()
+        return world
+
+    def add(self, obj: WorldObject) -> WorldObject:
+        """Add an object, give it the next instance id and register its category as a semantic class."""
+        if obj.name in self.objects:
+            raise ValueError(f"duplicate object name {obj.name!r}")
+        obj.instance_id = len(self.objects) + 1
+        self.semantic_id(obj.category)
+        self.objects[obj.name] = obj
+        self.version += 1
+        return obj
+
+    def semantic_id(self, category: str) -> int:
+        """The semantic class id of a category (structural classes first), registering it if new."""
+        try:
+            return self.class_names.index(category)
+        except ValueError:
+            self.class_names.append(category)
+            return len(self.class_names) - 1
+
+    def assign_labels(self) -> None:
+        """Give every object an alphabetical instance label per category ('fridge A', 'fridge B'), by name order."""
+        by_category: dict[str, list[WorldObject]] = {}
+        for obj in self.objects.values():
+            if obj.kind != "floor":
+                by_category.setdefault(obj.category, []).append(obj)
+        for category, objs in by_category.items():
+            for i, obj in enumerate(sorted(objs, key=lambda o: _natural_key(o.name))):
+                obj.label = f"{category} {_alpha(i)}"
+
+    # -- queries ------------------------------------------------------------------------------
+    def get(self, name: str) -> WorldObject:
+        """The object with this name (KeyError if none)."""
+        return self.objects[name]
+
+    def by_label(self, label: str) -> WorldObject | None:
+        """The object with this alphabetical label, if any."""
+        return next((o for o in self.objects.values() if o.label == label), None)
+
+    def children(self, name: str, relation: Relation | None = None) -> list[WorldObject]:
+        """Objects resting directly inside / on top of ``name``."""
+        return [o for o in self.objects.values() if o.parent == name and (relation is None or o.relation == relation)]
+
+    def ancestors(self, name: str) -> list[tuple[WorldObject, Relation]]:
+        """The chain of supports of ``name``, nearest first, with the relation to each."""
+        chain: list[tuple[WorldObject, Relation]] = []
+        obj = self.objects[name]
+        while obj.parent is not None and obj.relation is not None:
+            parent = self.objects[obj.parent]
+            chain.append((parent, obj.relation))
+            obj = parent
+        return chain
+
+    def is_inside(self, name: str, container: str) -> bool:
+        """True when ``name`` is within ``container``: directly, or on / in something that is inside it.
+
+        An apple on a plate in the fridge is inside the fridge; an apple in a bowl on a table is not
+        inside the table: what counts is the relation of the link that reaches ``container``.
+        """
+        return any(parent.name == container and rel == "inside" for parent, rel in self.ancestors(name))
+
+    def enclosing_closed_container(self, name: str) -> WorldObject | None:
+        """The outermost closed container that ``name`` is inside of, or None if nothing hides it."""
+        hidden_by = None
+        for parent, rel in self.ancestors(name):
+            if rel == "inside" and parent.openable and not parent.is_open:
+                hidden_by = parent
+        return hidden_by
+
+    def is_observable(self, name: str) -> bool:
+        """Whether sensors may see ``name``: not held and not shut away inside a closed container."""
+        if self.robot.held == name:
+            return False
+        return self.enclosing_closed_container(name) is None
+
+    def room_at(self, x: float, y: float) -> str | None:
+        """The room whose footprint contains (x, y), if any."""
+        for room in self.scene.rooms:
+            x0, y0, x1, y1 = room.bounds
+            if x0 <= x <= x1 and y0 <= y <= y1:
+                return room.id
+        return None
+
+    def items(self) -> list[WorldObject]:
+        """All movable objects."""
+        return [o for o in self.objects.values() if o.movable]
+
+    # -- changes ------------------------------------------------------------------------------
+    def set_open(self, name: str, is_open: bool) -> None:
+        """Open or close an openable object (no precondition checks: actions do those)."""
+        obj = self.objects[name]
+        if not obj.openable:
+            raise ValueError(f"{name} is not openable")
+        obj.is_open = is_open
+        self.version += 1
+
+    def place(self, name: str, parent: str, relation: Relation) -> None:
+        """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
+        obj, support = self.objects[name], self.objects[parent]
+        obj.parent, obj.relation = parent, relation
+        obj.center = self._free_slot(obj, support, relation)
+        obj.room = support.room
+        if self.robot.held == name:
+            self.robot.held = None
+        self.version += 1
+
+    def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
+        """Rest item ``name`` on a room floor at a given position (used by task instantiation)."""
+        obj, support = self.objects[name], self.objects[floor]
+        obj.parent, obj.relation, obj.room = floor, "ontop", support.room
+        obj.center = np.array([xy[0], xy[1], support.top + obj.size[2] / 2])
+        self.version += 1
+
+    def pick(self, name: str) -> None:
+        """Put item ``name`` in the robot's gripper, detached from its support (no precondition checks)."""
+        obj = self.objects[name]
+        obj.parent, obj.relation = None, None
+        self.robot.held = name
+        self.version += 1
+
+    def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
+        """Move the robot base; a held item moves along with it."""
+        self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
+        if self.robot.held is not None:
+            held = self.objects[self.robot.held]
+            held.center = np.array([x, y, 1.0])
+            held.room = self.room_at(x, y)
+        self.version += 1
+
+    # -- geometry helpers -----------------------------------------------------------------------
+    def support_surface(self, support: WorldObject, relation: Relation) -> tuple[np.ndarray, np.ndarray, float]:
+        """(footprint min xy, footprint max xy, surface z) where items rest in / on ``support``."""
+        lo, hi = support.box()
+        if relation == "ontop":
+            return lo[:2], hi[:2], support.top
+        slab = SLAB_FRACTION * support.size[2]
+        margin = np.minimum(0.05, support.size[:2] * 0.1)
+        return lo[:2] + margin, hi[:2] - margin, support.bottom + slab
+
+    def _free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray:
+        """Centre of the first slot on the support, in reading order, not overlapping its other items.
+
+        Items larger than the support, or a full support, fall back to the support's centre: magic
+        placement, like the paper's, never fails for lack of room.
+        """
+        lo, hi, z = self.support_surface(support, relation)
+        half = obj.size[:2] / 2 + SLOT_GAP_M / 2
+        others = [o for o in self.children(support.name, relation) if o.name != obj.name]
+        xs = np.arange(lo[0] + half[0], hi[0] - half[0] + 1e-9, 2 * half[0])
+        ys = np.arange(lo[1] + half[1], hi[1] - half[1] + 1e-9, 2 * half[1])
+        for y in ys:
+            for x in xs:
+                if not any(_overlap_xy((x, y), half, o) for o in others):
+                    return np.array([x, y, z + obj.size[2] / 2])
+        cx, cy = (lo + hi) / 2
+        return np.array([cx, cy, z + obj.size[2] / 2])
+
+
+def _overlap_xy(xy: tuple[float, float], half: np.ndarray, other: WorldObject) -> bool:
+    return bool(np.all(np.abs(np.asarray(xy) - other.center[:2]) < half + other.size[:2] / 2))
+
+
+def _alpha(i: int) -> str:
+    """0 -> A, 25 -> Z, 26 -> AA, ... (spreadsheet-style column letters)."""
+    letters = ""
+    i += 1
+    while i:
+        i, rem = divmod(i - 1, 26)
+        letters = string.ascii_uppercase[rem] + letters
+    return letters
+
+
+def _natural_key(name: str) -> list[object]:
+    """Sort 'apple_2' before 'apple_10'."""
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
