@@ -1,6 +1,62 @@
-"""``more-agent eval``: run many episodes, resumable. (Owned by the evaluation work.)"""
+"""``more-agent eval``: run a planner over a task set into DIR, resumable; then write DIR's reports."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from more_agent.commands._common import err_console, user_errors_exit_2
+from more_agent.errors import UserError
 
 
-def eval_() -> None:
-    """Evaluate a planner over a task set."""
-    raise NotImplementedError
+@user_errors_exit_2
+def eval_(
+    tasks: Annotated[str, typer.Option(help="Task set (more-paper, behavior-rearrange), a file of names, or 'a,b,c'.")],
+    planner: Annotated[str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr.")],
+    out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
+    llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
+    seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,
+    scene: Annotated[str | None, typer.Option(help="Scene for every task (default: each task's first matching scene).")] = None,
+    workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
+    ray_address: Annotated[
+        str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
+    ] = None,
+    resume: Annotated[bool, typer.Option(help="Continue the run in OUT: run only the missing episodes.")] = False,
+    max_llm_calls: Annotated[
+        int | None, typer.Option(min=1, help="Limit on concurrent LLM calls across all workers.")
+    ] = None,
+    max_retries: Annotated[int, typer.Option(min=0, help="Re-runs of an episode whose worker died.")] = 2,
+    episode_fn: Annotated[str | None, typer.Option(help="Episode function 'module:function' (advanced).")] = None,
+    progress: Annotated[bool, typer.Option(help="Show the progress bar.")] = True,
+) -> None:
+    """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl."""
+    from more_agent import __version__
+    from more_agent.eval.harness import DEFAULT_EPISODE_FN, evaluate, resolve_tasks
+    from more_agent.eval.report import load_runs, table_i_markdown, write_reports
+    from more_agent.eval.store import RunConfig, redact
+
+    if llm is not None and llm != redact(llm):
+        raise UserError("--llm must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
+    config = RunConfig(
+        planner=planner,
+        llm=llm,
+        tasks=resolve_tasks(tasks),
+        seeds=list(range(seeds)),
+        scene=scene,
+        episode_fn=episode_fn or DEFAULT_EPISODE_FN,
+        workers=workers,
+        ray_address=ray_address,
+        more_agent_version=__version__,
+    )
+    records = evaluate(
+        config, out, resume=resume, max_concurrent_llm=max_llm_calls, max_retries=max_retries, show_progress=progress
+    )
+    sourced, _ = load_runs([out])
+    paths = write_reports(sourced, out, title=f"{planner} on {tasks}")
+    typer.echo(table_i_markdown([s.record for s in sourced]))
+    errors = sum(r.error is not None for r in records)
+    if errors:
+        err_console.print(f"[yellow]{errors} episode(s) ended with an error; see {out / 'report.html'}[/]")
+    err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False)

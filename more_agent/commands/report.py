@@ -1,6 +1,33 @@
-"""``more-agent report DIR...``: merge runs into tables. (Owned by the evaluation work.)"""
+"""``more-agent report DIR [DIR ...]``: merge evaluation runs into one comparison table."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from more_agent.commands._common import err_console, user_errors_exit_2
 
 
-def report() -> None:
-    """Merge evaluation runs into one comparison table."""
-    raise NotImplementedError
+@user_errors_exit_2
+def report(
+    run_dirs: Annotated[list[Path], typer.Argument(help="Run directories written by 'more-agent eval'.")],
+    out: Annotated[
+        Path | None, typer.Option(help="Also write summary.md, summary.csv and report.html here.")
+    ] = None,
+    per_task: Annotated[bool, typer.Option(help="Print the per-task table too.")] = False,
+) -> None:
+    """Print Table I (SR / TTC / TP / rTP with 95% intervals) over the merged runs."""
+    from more_agent.eval.report import load_runs, per_task_markdown, table_i_markdown, write_reports
+
+    sourced, dropped = load_runs(run_dirs)
+    records = [s.record for s in sourced]
+    typer.echo(table_i_markdown(records))
+    if per_task:
+        typer.echo("\n" + per_task_markdown(records))
+    if dropped:
+        err_console.print(f"[yellow]{dropped} duplicate episode(s) dropped (the first run listed wins)[/]")
+    if out is not None:
+        paths = write_reports(sourced, out, title="Comparison of " + ", ".join(str(d) for d in run_dirs))
+        err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False)

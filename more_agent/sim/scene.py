@@ -108,6 +108,19 @@ class Door(_Strict):
         return (x - hw, y - ht, x + hw, y + ht) if self.axis == "x" else (x - ht, y - hw, x + ht, y + hw)
 
 
+class GroundPatch(_Strict):
+    """A rectangle of another ground class inside a room: a carpet under a rug, a garden's driveway."""
+
+    room: str = Field(description="Id of the room it lies in.")
+    bounds: Bounds2D = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres, within the room.")
+    ground: GroundClass = Field(description="Ground class of the patch; it overrides the room's ground.")
+
+    @model_validator(mode="after")
+    def _valid_bounds(self) -> GroundPatch:
+        _check_bounds(self.bounds, "ground patch")
+        return self
+
+
 class Furniture(_Strict):
     """A piece of scene furniture (fixed in place): an axis-aligned box, maybe openable."""
 
@@ -143,6 +156,7 @@ class Scene(_Strict):
     doors: list[Door] = Field(default_factory=list)
     windows: list[Window] = Field(default_factory=list)
     furniture: list[Furniture] = Field(default_factory=list)
+    ground_patches: list[GroundPatch] = Field(default_factory=list, description="Carpets and driveways within rooms.")
 
     @model_validator(mode="after")
     def _consistent(self) -> Scene:
@@ -158,6 +172,9 @@ class Scene(_Strict):
         for i, f in enumerate(self.furniture):
             if f.room not in known:
                 raise ValueError(f"furniture[{i}] ({f.id}) names unknown room {f.room!r}")
+        for i, p in enumerate(self.ground_patches):
+            if p.room not in known:
+                raise ValueError(f"ground_patches[{i}] names unknown room {p.room!r}")
         return self
 
     def room(self, room_id: str) -> Room:

@@ -170,6 +170,14 @@ class World:
             obj = parent
         return chain
 
+    def descendants(self, name: str) -> list[WorldObject]:
+        """Everything resting in / on ``name``, directly or through other objects (depth first)."""
+        found: list[WorldObject] = []
+        for child in self.children(name):
+            found.append(child)
+            found.extend(self.descendants(child.name))
+        return found
+
     def is_inside(self, name: str, container: str) -> bool:
         """True when ``name`` is within ``container``: directly, or on / in something that is inside it.
 
@@ -217,8 +225,8 @@ class World:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
         obj, support = self.objects[name], self.objects[parent]
         obj.parent, obj.relation = parent, relation
-        obj.center = self._free_slot(obj, support, relation)
         obj.room = support.room
+        self._move_subtree(obj, self._free_slot(obj, support, relation))
         if self.robot.held == name:
             self.robot.held = None
         self.version += 1
@@ -227,7 +235,7 @@ class World:
         """Rest item ``name`` on a room floor at a given position (used by task instantiation)."""
         obj, support = self.objects[name], self.objects[floor]
         obj.parent, obj.relation, obj.room = floor, "ontop", support.room
-        obj.center = np.array([xy[0], xy[1], support.top + obj.size[2] / 2])
+        self._move_subtree(obj, np.array([xy[0], xy[1], support.top + obj.size[2] / 2]))
         self.version += 1
 
     def pick(self, name: str) -> None:
@@ -242,9 +250,17 @@ class World:
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         if self.robot.held is not None:
             held = self.objects[self.robot.held]
-            held.center = np.array([x, y, 1.0])
             held.room = self.room_at(x, y)
+            self._move_subtree(held, np.array([x, y, 1.0]))
         self.version += 1
+
+    def _move_subtree(self, obj: WorldObject, center: np.ndarray) -> None:
+        """Move ``obj`` to ``center``; what rests in / on it moves by the same offset (and changes room)."""
+        delta = center - obj.center
+        obj.center = center
+        for d in self.descendants(obj.name):
+            d.center = d.center + delta
+            d.room = obj.room
 
     # -- geometry helpers -----------------------------------------------------------------------
     def support_surface(self, support: WorldObject, relation: Relation) -> tuple[np.ndarray, np.ndarray, float]:

@@ -1,0 +1,309 @@
+"""The evaluation harness: task-set expansion, episode execution in processes or on Ray, resumable runs.
+
+The harness knows only an *episode function* ``fn(spec: EpisodeSpec, *, out_dir: Path) ->
+EpisodeRecord``, named by a dotted path (``"package.module:function"``) so that any worker process
+or Ray node can import it; the default is ``more_agent.eval.episode:run_episode``, resolved lazily.
+Records are appended to ``DIR/episodes.jsonl`` by this (parent) process only, as they finish.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import multiprocessing
+import os
+import threading
+import time
+import traceback
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
+
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+from more_agent.errors import UserError
+from more_agent.eval.limits import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.store import (
+    EPISODE_DIRS,
+    EPISODES_FILE,
+    EpisodeWriter,
+    RunConfig,
+    episode_dirname,
+    pending,
+    prepare_run_dir,
+)
+
+DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
+"""Dotted path of the real episode function."""
+
+TASK_SETS = ("more-paper", "behavior-rearrange")
+"""Task-set names ``--tasks`` accepts; resolved by ``more_agent.sim.tasks.task_set``."""
+
+DEFAULT_MAX_RETRIES = 2
+"""Re-runs of an episode whose worker process died before it is recorded as an error."""
+
+EpisodeFn = Callable[..., EpisodeRecord]
+
+
+# ---------------------------------------------------------------------------------------------
+# What to run
+
+
+def _default_task_set(name: str) -> list[str]:
+    from more_agent.sim.tasks import task_set  # lazy: the simulator is heavy and not needed here
+
+    return list(task_set(name))
+
+
+def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = None) -> list[str]:
+    """Task names from ``--tasks``: a set name, a file (one name per line or a JSON list), or 'a,b,c'.
+
+    Duplicates are dropped, order kept. Lines starting with '#' in a file are comments.
+    """
+    arg = arg.strip()
+    path = Path(arg)
+    if arg in TASK_SETS:
+        names = (task_set or _default_task_set)(arg)
+    elif path.is_file():
+        text = path.read_text(encoding="utf-8")
+        if text.lstrip().startswith("["):
+            try:
+                names = json.loads(text)
+            except json.JSONDecodeError as e:
+                raise UserError(f"{path}: not a JSON list of task names: {e}") from None
+            if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+                raise UserError(f"{path}: expected a JSON list of task names (strings)")
+        else:
+            names = [ln.strip() for ln in text.splitlines() if ln.strip() and not ln.strip().startswith("#")]
+    elif "/" in arg or arg.endswith((".txt", ".json")):
+        raise UserError(f"task file {arg} does not exist")
+    else:
+        names = [n.strip() for n in arg.split(",") if n.strip()]
+    names = list(dict.fromkeys(n.strip() for n in names))
+    if not names:
+        raise UserError(f"--tasks {arg!r} names no task; use a set ({', '.join(TASK_SETS)}), a file or 'a,b,c'")
+    return names
+
+
+def config_specs(config: RunConfig) -> list[EpisodeSpec]:
+    """Every episode of a run: tasks x seeds, task-major."""
+    return [
+        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm)
+        for t in config.tasks
+        for s in config.seeds
+    ]
+
+
+def episode_fn_path(fn: str | EpisodeFn) -> str:
+    """The dotted path of an episode function; a callable must be a module-level function."""
+    if isinstance(fn, str):
+        return fn
+    path = f"{fn.__module__}:{fn.__qualname__}"
+    if "<" in path or fn.__module__ == "__main__":
+        raise UserError(f"episode function {path} must be a top-level function of an importable module")
+    return path
+
+
+def resolve_episode_fn(path: str) -> EpisodeFn:
+    """Import an episode function from 'pkg.module:function' (or 'pkg.module.function')."""
+    module, sep, name = path.partition(":")
+    if not sep:
+        module, _, name = path.rpartition(".")
+    try:
+        fn = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError, ValueError) as e:
+        raise UserError(f"cannot import episode function {path!r}: {e}") from None
+    if not callable(fn):
+        raise UserError(f"episode function {path!r} is not callable")
+    return fn
+
+
+# ---------------------------------------------------------------------------------------------
+# Running one episode (in any process)
+
+
+def error_record(spec: EpisodeSpec, error: str, tb: str | None = None) -> EpisodeRecord:
+    """The record of an episode that raised or whose worker died: a failure with its error."""
+    return EpisodeRecord(
+        task=spec.task,
+        scene=spec.scene or "",
+        seed=spec.seed,
+        planner=spec.planner,
+        llm=spec.llm,
+        error=error,
+        traceback=tb,
+    )
+
+
+def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:
+    """Run one episode; an exception becomes an error record. Idempotent: writes only its own dir."""
+    out_dir = Path(run_dir) / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+    start = time.perf_counter()
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        record = resolve_episode_fn(fn_path)(spec, out_dir=out_dir)
+        if not isinstance(record, EpisodeRecord):
+            raise TypeError(f"episode function returned {type(record).__name__}, not EpisodeRecord")
+        return record
+    except Exception as e:  # noqa: BLE001 - any episode failure is recorded, the run goes on
+        rec = error_record(spec, f"{type(e).__name__}: {e}", traceback.format_exc())
+        return rec.model_copy(update={"timings": {"total": time.perf_counter() - start}})
+
+
+def _exit_when_orphaned(parent_pid: int) -> None:
+    while os.getppid() == parent_pid:
+        time.sleep(0.5)
+    os._exit(1)
+
+
+def _init_worker(limiter: LLMConcurrencyLimiter | None, parent_pid: int) -> None:
+    """Pool worker start-up: install the shared LLM limiter and exit if the parent dies."""
+    set_llm_limiter(limiter)
+    threading.Thread(target=_exit_when_orphaned, args=(parent_pid,), daemon=True).start()
+
+
+def iter_inline(specs: Sequence[EpisodeSpec], *, fn_path: str, run_dir: Path) -> Iterator[EpisodeRecord]:
+    """Run episodes one after another in this process."""
+    for spec in specs:
+        yield execute_episode(fn_path, spec, str(run_dir))
+
+
+def iter_processes(
+    specs: Sequence[EpisodeSpec],
+    *,
+    fn_path: str,
+    run_dir: Path,
+    workers: int,
+    start_method: str = "spawn",
+    max_concurrent_llm: int | None = None,
+    max_retries: int = DEFAULT_MAX_RETRIES,
+) -> Iterator[EpisodeRecord]:
+    """Run episodes in a process pool, yielding records as they finish.
+
+    At most ``workers`` episodes are submitted at a time, so when a worker dies (the pool breaks)
+    only the episodes then in flight are charged: they are re-run in a fresh pool, each at most
+    ``max_retries`` times, then recorded as errors.
+    """
+    ctx = multiprocessing.get_context(start_method)
+    limiter = ProcessLimiter.create(ctx, max_concurrent_llm) if max_concurrent_llm else None
+    queue = deque(range(len(specs)))
+    deaths = [0] * len(specs)
+    while queue:
+        pool = ProcessPoolExecutor(
+            max_workers=min(workers, len(queue)),
+            mp_context=ctx,
+            initializer=_init_worker,
+            initargs=(limiter, os.getpid()),
+        )
+        inflight: dict[Future[EpisodeRecord], int] = {}
+        retry: list[int] = []
+        broken = False
+        try:
+            while inflight or (queue and not broken):
+                while queue and len(inflight) < workers and not broken:
+                    i = queue.popleft()
+                    try:
+                        inflight[pool.submit(execute_episode, fn_path, specs[i], str(run_dir))] = i
+                    except BrokenProcessPool:
+                        queue.appendleft(i)
+                        broken = True
+                done, _ = wait(inflight, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    i = inflight.pop(fut)
+                    try:
+                        record = fut.result()
+                    except BrokenProcessPool:
+                        broken = True
+                        deaths[i] += 1
+                        if deaths[i] <= max_retries:
+                            retry.append(i)
+                            continue
+                        record = error_record(specs[i], f"WorkerDied: worker process died {deaths[i]} times")
+                    yield record
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        queue.extendleft(reversed(retry))
+
+
+# ---------------------------------------------------------------------------------------------
+# A whole run
+
+
+def _progress(console: Console, *, show: bool) -> Progress:
+    return Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("SR {task.fields[sr]}"),
+        TextColumn("errors {task.fields[errors]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+        console=console,
+        disable=not show,
+    )
+
+
+def evaluate(
+    config: RunConfig,
+    run_dir: Path,
+    *,
+    resume: bool = False,
+    max_concurrent_llm: int | None = None,
+    max_retries: int = DEFAULT_MAX_RETRIES,
+    start_method: str = "spawn",
+    show_progress: bool = True,
+    console: Console | None = None,
+) -> list[EpisodeRecord]:
+    """Run every missing episode of ``config`` into ``run_dir`` and return all of the run's records.
+
+    Workers: ``config.ray_address`` set -> Ray (``'local'`` starts a local Ray); else
+    ``config.workers`` > 1 -> a process pool; else this process.
+    """
+    run_dir = Path(run_dir)
+    resolve_episode_fn(config.episode_fn)  # fail early, in the parent, on a bad path
+    specs = config_specs(config)
+    records = prepare_run_dir(run_dir, config, resume=resume)
+    todo = pending(specs, records)
+    if config.ray_address:
+        from more_agent.eval.ray_backend import iter_ray
+
+        stream: Iterable[EpisodeRecord] = iter_ray(
+            todo,
+            fn_path=config.episode_fn,
+            run_dir=run_dir,
+            address=config.ray_address,
+            max_concurrent_llm=max_concurrent_llm,
+            max_retries=max_retries,
+        )
+    elif config.workers > 1 and len(todo) > 1:
+        stream = iter_processes(
+            todo,
+            fn_path=config.episode_fn,
+            run_dir=run_dir,
+            workers=config.workers,
+            start_method=start_method,
+            max_concurrent_llm=max_concurrent_llm,
+            max_retries=max_retries,
+        )
+    else:
+        stream = iter_inline(todo, fn_path=config.episode_fn, run_dir=run_dir)
+    console = console or Console(stderr=True)
+    with EpisodeWriter(run_dir / EPISODES_FILE) as writer, _progress(console, show=show_progress) as bar:
+        successes, errors = sum(r.success for r in records), sum(r.error is not None for r in records)
+        done = len(records)
+
+        def fields() -> dict[str, str]:
+            return {"sr": f"{successes / done:.1%}" if done else "-", "errors": str(errors)}
+
+        bar_id = bar.add_task(config.planner, total=len(todo), **fields())
+        for record in stream:
+            writer.append(record)
+            records.append(record)
+            done, successes, errors = done + 1, successes + record.success, errors + (record.error is not None)
+            bar.update(bar_id, advance=1, **fields())
+    return records

@@ -1,0 +1,170 @@
+"""Table I metrics (SR, TTC, TP, rTP) as pure functions of ``EpisodeRecord`` lists, with 95% CIs.
+
+Per-episode values:
+
+- SR: ``record.success`` (all goal conditions met and ``done()`` called).
+- TTC: ``record.all_goals_met`` (all met, whether or not ``done()`` was called).
+- TP: ``record.task_progress`` (share of goal conditions met).
+- rTP: share of met conditions among the *observed* ones; a condition is observed when every
+  instance in its ``objects`` is in ``record.observed_objects`` (a condition that names no object
+  counts as observed). When an episode observed none of its conditions (or has none), its rTP is
+  **0.0**: the robot never saw what the task is about, so it made no relative progress. This keeps
+  the same n for all four metrics and never rewards a planner for not exploring.
+
+Episodes that raised (``record.error`` set) are kept: they count as failures with the values their
+record holds (the harness writes zeros). Aggregates are episode-weighted (each episode counts once;
+with equal seeds per task this equals the mean over tasks of the per-task means).
+
+Intervals: Wilson score for the rates SR and TTC; percentile bootstrap (seeded, deterministic)
+for the means TP and rTP.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from more_agent.eval.record import EpisodeRecord
+
+Z_95 = 1.959963984540054
+"""Two-sided 95% normal quantile."""
+
+BOOTSTRAP_RESAMPLES = 2000
+"""Bootstrap resamples for the TP / rTP intervals."""
+
+METRIC_NAMES = ("SR", "TTC", "TP", "rTP")
+
+
+def sr(record: EpisodeRecord) -> float:
+    """Success: all goal conditions met and done() called."""
+    return 1.0 if record.success else 0.0
+
+
+def ttc(record: EpisodeRecord) -> float:
+    """Total task completion: all goal conditions met, done() or not."""
+    return 1.0 if record.all_goals_met else 0.0
+
+
+def tp(record: EpisodeRecord) -> float:
+    """Task progression: share of goal conditions met."""
+    return float(record.task_progress)
+
+
+def rtp(record: EpisodeRecord) -> float:
+    """Relative task progression: share of met conditions among those whose objects were all observed.
+
+    0.0 when no condition was observed (see the module docstring).
+    """
+    seen = set(record.observed_objects)
+    observed = [c for c in record.goal_conditions if all(o in seen for o in c.objects)]
+    if not observed:
+        return 0.0
+    return sum(c.satisfied for c in observed) / len(observed)
+
+
+PER_EPISODE: dict[str, Callable[[EpisodeRecord], float]] = {"SR": sr, "TTC": ttc, "TP": tp, "rTP": rtp}
+"""Metric name -> per-episode value function."""
+
+
+class Estimate(BaseModel):
+    """A mean over episodes with its 95% confidence interval."""
+
+    model_config = ConfigDict(frozen=True)
+
+    mean: float = Field(description="Mean over episodes, in [0, 1].")
+    low: float = Field(description="Lower end of the 95% interval.")
+    high: float = Field(description="Upper end of the 95% interval.")
+    n: int = Field(description="Number of episodes.")
+    method: str = Field(description="'wilson' or 'bootstrap'.")
+
+
+class MetricSummary(BaseModel):
+    """The four Table I metrics over one group of episodes, plus counts."""
+
+    model_config = ConfigDict(frozen=True)
+
+    n: int = Field(description="Episodes in the group.")
+    n_tasks: int = Field(description="Distinct tasks in the group.")
+    n_errors: int = Field(description="Episodes that ended with an error (counted as failures).")
+    SR: Estimate
+    TTC: Estimate
+    TP: Estimate
+    rTP: Estimate
+
+
+def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
+    """Wilson score interval for a binomial proportion; (0, 1) when n == 0."""
+    if n == 0:
+        return 0.0, 1.0
+    p = successes / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def bootstrap_interval(
+    values: Sequence[float], *, resamples: int = BOOTSTRAP_RESAMPLES, seed: int = 0
+) -> tuple[float, float]:
+    """Percentile bootstrap 95% interval of the mean; (0, 1) for no values. Independent of value order."""
+    x = np.sort(np.asarray(values, dtype=float))
+    if x.size == 0:
+        return 0.0, 1.0
+    rng = np.random.default_rng(seed)
+    means = x[rng.integers(0, x.size, size=(resamples, x.size))].mean(axis=1)
+    low, high = np.quantile(means, [0.025, 0.975])
+    return float(low), float(high)
+
+
+def estimate(records: Sequence[EpisodeRecord], metric: str) -> Estimate:
+    """Mean and 95% interval of one metric ('SR', 'TTC', 'TP', 'rTP') over ``records``."""
+    values = sorted(PER_EPISODE[metric](r) for r in records)  # sorted: the result ignores record order
+    n = len(values)
+    mean = float(np.mean(values)) if n else 0.0
+    if metric in ("SR", "TTC"):
+        low, high = wilson_interval(int(round(sum(values))), n)
+        return Estimate(mean=mean, low=low, high=high, n=n, method="wilson")
+    low, high = bootstrap_interval(values)
+    return Estimate(mean=mean, low=low, high=high, n=n, method="bootstrap")
+
+
+def summarize(records: Sequence[EpisodeRecord]) -> MetricSummary:
+    """All four metrics with intervals and counts over one group of episodes."""
+    return MetricSummary(
+        n=len(records),
+        n_tasks=len({r.task for r in records}),
+        n_errors=sum(r.error is not None for r in records),
+        **{m: estimate(records, m) for m in METRIC_NAMES},
+    )
+
+
+def system_label(record: EpisodeRecord) -> str:
+    """Row label of a record's system in comparison tables: the planner, plus the LLM if any."""
+    return f"{record.planner} ({record.llm})" if record.llm else record.planner
+
+
+def group_by(
+    records: Iterable[EpisodeRecord], key: Callable[[EpisodeRecord], str]
+) -> dict[str, list[EpisodeRecord]]:
+    """Records grouped by ``key``, groups in sorted key order, records in input order."""
+    groups: dict[str, list[EpisodeRecord]] = {}
+    for r in records:
+        groups.setdefault(key(r), []).append(r)
+    return dict(sorted(groups.items()))
+
+
+def by_system(records: Iterable[EpisodeRecord]) -> dict[str, MetricSummary]:
+    """Overall metrics per system (planner + LLM): the rows of Table I."""
+    return {k: summarize(v) for k, v in group_by(records, system_label).items()}
+
+
+def by_task(records: Iterable[EpisodeRecord]) -> dict[tuple[str, str], MetricSummary]:
+    """Metrics per (system, task)."""
+    out: dict[tuple[str, str], MetricSummary] = {}
+    for system, recs in group_by(records, system_label).items():
+        for task, task_recs in group_by(recs, lambda r: r.task).items():
+            out[(system, task)] = summarize(task_recs)
+    return out

@@ -1,0 +1,123 @@
+"""Reports of evaluation runs: Table I (summary.md), per-task tables, summary.csv, report.html; merging runs.
+
+Rows of Table I are systems (planner, plus LLM when there is one); every cell is the mean in percent
+with its 95% interval; n and the number of errored episodes are their own columns.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+from more_agent.errors import UserError
+from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task
+from more_agent.eval.record import EpisodeRecord
+from more_agent.eval.store import EPISODES_FILE, read_records
+
+SUMMARY_MD = "summary.md"
+SUMMARY_CSV = "summary.csv"
+REPORT_HTML = "report.html"
+ALL_TASKS = "ALL"
+"""Task column value of the overall rows in summary.csv."""
+
+
+class SourcedRecord(NamedTuple):
+    """A record and the run directory it was read from (for per-episode files such as map.png)."""
+
+    record: EpisodeRecord
+    run_dir: Path
+
+
+def load_runs(run_dirs: Sequence[Path]) -> tuple[list[SourcedRecord], int]:
+    """Records of several runs merged, and how many duplicates were dropped (first run wins).
+
+    Duplicates are records with the same (task, scene, seed, planner, llm).
+    """
+    seen: set[tuple[str, str, int, str, str | None]] = set()
+    out: list[SourcedRecord] = []
+    dropped = 0
+    for d in map(Path, run_dirs):
+        if not (d / EPISODES_FILE).is_file():
+            raise UserError(f"{d} is not an evaluation run (no {EPISODES_FILE})")
+        for r in read_records(d / EPISODES_FILE):
+            key = (*r.key(), r.llm)
+            if key in seen:
+                dropped += 1
+                continue
+            seen.add(key)
+            out.append(SourcedRecord(r, d))
+    return out, dropped
+
+
+def fmt(e: Estimate) -> str:
+    """'48.1 [40.2, 55.3]': mean and 95% interval in percent."""
+    return f"{100 * e.mean:.1f} [{100 * e.low:.1f}, {100 * e.high:.1f}]"
+
+
+def _md_table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def _cells(s: MetricSummary) -> list[str]:
+    return [fmt(getattr(s, m)) for m in METRIC_NAMES]
+
+
+def table_i_markdown(records: Sequence[EpisodeRecord]) -> str:
+    """Table I: one row per system, SR / TTC / TP / rTP in percent with 95% intervals."""
+    header = ["System", "n", "tasks", "errors", *(f"{m} [%]" for m in METRIC_NAMES)]
+    rows = [[k, str(s.n), str(s.n_tasks), str(s.n_errors), *_cells(s)] for k, s in by_system(records).items()]
+    return _md_table(header, rows)
+
+
+def per_task_markdown(records: Sequence[EpisodeRecord]) -> str:
+    """One row per (system, task)."""
+    header = ["System", "Task", "n", "errors", *(f"{m} [%]" for m in METRIC_NAMES)]
+    rows = [[k, t, str(s.n), str(s.n_errors), *_cells(s)] for (k, t), s in by_task(records).items()]
+    return _md_table(header, rows)
+
+
+def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluation summary") -> str:
+    """The whole summary.md: Table I, notes on the metrics, the per-task table."""
+    return "\n\n".join(
+        [
+            f"# {title}",
+            table_i_markdown(records),
+            "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
+            "rTP. Episodes are weighted equally; errored episodes count as failures. rTP is 0 for an "
+            "episode that observed none of its goal conditions' objects.",
+            "## Per task",
+            per_task_markdown(records),
+        ]
+    ) + "\n"
+
+
+def summary_csv(records: Sequence[EpisodeRecord]) -> str:
+    """summary.csv: one row per system overall (task = 'ALL') and per (system, task)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["system", "task", "n", "n_tasks", "n_errors", *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high"))])
+    rows = [((k, ALL_TASKS), s) for k, s in by_system(records).items()] + list(by_task(records).items())
+    for (system, task), s in rows:
+        est = [getattr(s, m) for m in METRIC_NAMES]
+        w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *(f"{v:.6f}" for e in est for v in (e.mean, e.low, e.high))])
+    return buf.getvalue()
+
+
+def write_reports(sourced: Sequence[SourcedRecord], out_dir: Path, *, title: str = "Evaluation summary") -> list[Path]:
+    """Write summary.md, summary.csv and report.html into ``out_dir``; return their paths."""
+    from more_agent.viz.report_html import render_report  # lazy: only reports need the HTML code
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    records = [s.record for s in sourced]
+    paths = [out_dir / SUMMARY_MD, out_dir / SUMMARY_CSV, out_dir / REPORT_HTML]
+    paths[0].write_text(summary_markdown(records, title=title), encoding="utf-8")
+    paths[1].write_text(summary_csv(records), encoding="utf-8")
+    paths[2].write_text(render_report(sourced, title=title), encoding="utf-8")
+    return paths
+

@@ -1,0 +1,106 @@
+"""The skill API and the shapes of the three LLM answers (room label, scene filter, next action).
+
+The pydantic answer models double as JSON schemas for structured output: every field is required
+and extra keys are forbidden, as OpenAI's strict mode wants. The validated results the planners
+consume are the frozen :class:`PlannedAction` and :class:`FilterResult`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+ParamKind = Literal["room", "object"]
+
+
+@dataclass(frozen=True)
+class Skill:
+    """One subpolicy the planner may call: name, parameter kinds in order, one-line description."""
+
+    name: str
+    params: tuple[ParamKind, ...]
+    description: str
+
+    @property
+    def signature(self) -> str:
+        """E.g. ``navigate(room, object)``."""
+        return f"{self.name}({', '.join(self.params)})"
+
+
+DEFAULT_SKILLS: tuple[Skill, ...] = (
+    Skill("explore", ("room",), "explore the closest unexplored area (frontier) in the room"),
+    Skill("navigate", ("room", "object"), "go to the object"),
+    Skill("go_to_and_open", ("room", "object"), "go to the object and open it"),
+    Skill("go_to_and_close", ("room", "object"), "go to the object and close it"),
+    Skill("go_to_and_grasp", ("room", "object"), "go to the object and pick it up (the hand must be empty)"),
+    Skill("go_to_and_place_inside", ("room", "object"), "go to the object and put the held object inside it"),
+    Skill("go_to_and_place_ontop", ("room", "object"), "go to the object and put the held object on top of it"),
+    Skill("done", (), "end the episode because the task is complete"),
+)
+"""The paper's subpolicies (Sec. III-C)."""
+
+
+class _Answer(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class RoomLabelAnswer(_Answer):
+    """Answer to room classification."""
+
+    room: str = Field(description="The room type, one of the offered labels.")
+
+
+class RoomObjects(_Answer):
+    """One room kept by the filter and its relevant objects."""
+
+    room: str = Field(description="Room name exactly as in the scene description.")
+    objects: list[str] = Field(description="Relevant object names in this room, exactly as in the scene description.")
+
+
+class FilterAnswer(_Answer):
+    """Answer to scene filtering: the task-relevant rooms and their relevant objects."""
+
+    rooms: list[RoomObjects] = Field(description="Relevant rooms, each with its relevant objects (possibly none).")
+
+
+class PlanAnswer(_Answer):
+    """Answer to planning: a short reasoning and one skill call."""
+
+    reasoning: str = Field(description="One or two short sentences on why this action.")
+    skill: str = Field(description="Name of the skill to call.")
+    arguments: list[str] = Field(description="Arguments in order: room and/or object names; empty for done().")
+
+
+@dataclass(frozen=True)
+class PlannedAction:
+    """A validated skill call; names are the canonical scene names."""
+
+    skill: str
+    arguments: tuple[str, ...]
+    room: str | None
+    """The room argument, if the skill takes one."""
+    object: str | None
+    """The object argument, if the skill takes one."""
+    reasoning: str = ""
+
+    @property
+    def call(self) -> str:
+        """E.g. ``go_to_and_grasp(kitchen_0, apple_a)``, as shown in the action history."""
+        return f"{self.skill}({', '.join(self.arguments)})"
+
+
+@dataclass(frozen=True)
+class FilterResult:
+    """The filtered scene: kept rooms -> kept objects (known names only), plus what was dropped."""
+
+    rooms: Mapping[str, tuple[str, ...]]
+    unknown_rooms: tuple[str, ...]
+    unknown_objects: tuple[str, ...]
+
+    @property
+    def objects(self) -> tuple[str, ...]:
+        """All kept objects, room by room."""
+        return tuple(o for objs in self.rooms.values() for o in objs)

@@ -1,0 +1,110 @@
+"""Typed errors of the LLM layer, one class per cause.
+
+Two families: :class:`LLMError` for things that go wrong while talking to a model (transport,
+server, answer content) and :class:`LLMConfigError` (a :class:`~more_agent.errors.UserError`) for
+things the user must fix (bad spec, missing key, missing extra). Callers catch by cause, e.g.
+``except (LLMTimeout, LLMRateLimited)``; the episode loop catches :class:`InvalidAnswer`.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from more_agent.errors import UserError
+
+if TYPE_CHECKING:
+    from more_agent.llm.completion import Completion
+
+
+class LLMError(Exception):
+    """Base class of everything that goes wrong while asking a model."""
+
+
+class LLMTransportError(LLMError):
+    """The request did not produce an answer; ``attempts`` says how many tries were made."""
+
+    def __init__(self, message: str, *, attempts: int = 1) -> None:
+        super().__init__(message)
+        self.attempts = attempts
+
+
+class LLMTimeout(LLMTransportError):
+    """The server did not answer within the configured timeout (after all retries)."""
+
+
+class LLMConnectionError(LLMTransportError):
+    """The server could not be reached or dropped the connection (after all retries)."""
+
+
+class LLMStatusError(LLMTransportError):
+    """The server answered with an HTTP error status."""
+
+    def __init__(self, message: str, *, status_code: int, attempts: int = 1) -> None:
+        super().__init__(message, attempts=attempts)
+        self.status_code = status_code
+
+
+class LLMRateLimited(LLMStatusError):
+    """HTTP 429 on every attempt."""
+
+
+class LLMServerError(LLMStatusError):
+    """HTTP 5xx (or another retryable status) on every attempt."""
+
+
+class LLMBadRequest(LLMStatusError):
+    """HTTP 4xx the server will not change its mind about (400, 404, 422, ...); never retried."""
+
+
+class LLMAuthError(LLMStatusError):
+    """HTTP 401/403: the API key is missing, wrong or lacks access; never retried."""
+
+
+class Unparseable(LLMError):
+    """The answer holds no JSON object although one was asked for; ``completion`` is the answer."""
+
+    def __init__(self, message: str, *, completion: Completion) -> None:
+        super().__init__(message)
+        self.completion = completion
+
+
+class InvalidAnswer(LLMError):
+    """The answer parsed but does not name a valid action / room / object; ``reason`` says why.
+
+    ``completions`` holds the answers that led here (so their usage is still counted).
+    """
+
+    def __init__(self, reason: str, *, completions: tuple[Completion, ...] = ()) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.completions = completions
+
+
+class ReplayMiss(LLMError):
+    """Replay mode found no cached answer for a request: the run differs from the recorded one."""
+
+    def __init__(self, *, key: str, model: str, purpose: str) -> None:
+        what = f" for {purpose!r}" if purpose else ""
+        super().__init__(
+            f"replay: no cached answer{what} (model {model!r}, key {key[:16]}...); the run has diverged "
+            "from the recorded one or the cache file is not the one it was recorded into"
+        )
+        self.key = key
+        self.model = model
+        self.purpose = purpose
+
+
+class LLMConfigError(UserError):
+    """The LLM configuration cannot work: bad file, bad value, missing key."""
+
+
+class BadLLMSpec(LLMConfigError):
+    """An ``--llm`` value is not ``openai:MODEL`` or ``llamacpp:PATH.gguf``."""
+
+
+class MissingAPIKey(LLMConfigError):
+    """The official OpenAI endpoint was asked for without an API key."""
+
+
+class MissingExtra(LLMConfigError):
+    """An optional dependency is not installed; the message names the extra to install."""

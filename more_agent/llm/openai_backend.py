@@ -1,0 +1,201 @@
+"""Backend for any OpenAI-compatible chat-completions endpoint (OpenAI, Azure v1, vLLM, Ollama, llama.cpp).
+
+Built on the ``openai`` SDK with its own retries switched off (``max_retries=0``): the retry loop
+here retries timeouts, connection drops, 429 (honouring ``retry-after``) and 5xx with exponential
+backoff and jitter, then raises the typed error of the last failure. A JSON schema is sent as
+``response_format`` when structured output is on; in ``auto`` mode a 400 to that request switches
+this backend to plain text for good (the client then extracts the JSON from the text).
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from more_agent.llm import constants as C
+from more_agent.llm.client import ChatRequest, Generation
+from more_agent.llm.config import LLMConfig, StructuredOutput
+from more_agent.llm.errors import (
+    LLMAuthError,
+    LLMBadRequest,
+    LLMConnectionError,
+    LLMRateLimited,
+    LLMServerError,
+    LLMTimeout,
+    LLMTransportError,
+    MissingAPIKey,
+)
+
+if TYPE_CHECKING:
+    import openai
+
+log = logging.getLogger(__name__)
+
+
+def _retry_after_s(headers: Any) -> float | None:
+    """Seconds a server asked us to wait (``retry-after-ms`` or ``retry-after`` in seconds), if any."""
+    for name, scale in (("retry-after-ms", 1e-3), ("retry-after", 1.0)):
+        value = headers.get(name) if headers is not None else None
+        if value is not None:
+            try:
+                return max(0.0, float(value) * scale)
+            except ValueError:
+                continue
+    return None
+
+
+class OpenAIBackend:
+    """Chat completions over HTTP; the SDK client is created on the first request, never at import."""
+
+    kind = "openai"
+    free = False
+
+    def __init__(
+        self,
+        *,
+        model: str,
+        base_url: str,
+        api_key: str,
+        timeout_s: float = C.DEFAULT_TIMEOUT_S,
+        max_retries: int = C.DEFAULT_MAX_RETRIES,
+        backoff_initial_s: float = C.INITIAL_BACKOFF_S,
+        backoff_max_s: float = C.MAX_BACKOFF_S,
+        structured_output: StructuredOutput = StructuredOutput.AUTO,
+        sleep: Callable[[float], None] = time.sleep,
+        rng: random.Random | None = None,
+    ) -> None:
+        self.model = model
+        self.base_url = base_url
+        self._api_key = api_key
+        self.timeout_s = timeout_s
+        self.max_retries = max_retries
+        self.backoff_initial_s = backoff_initial_s
+        self.backoff_max_s = backoff_max_s
+        self.structured_output = structured_output
+        self.schema_supported = structured_output is not StructuredOutput.NEVER
+        """False once the server rejected response_format (auto mode) or when it is off."""
+        self._sleep = sleep
+        self._rng = rng or random.Random()
+        self._sdk: openai.OpenAI | None = None
+
+    def __repr__(self) -> str:
+        return f"OpenAIBackend(model={self.model!r}, base_url={self.base_url!r})"
+
+    @classmethod
+    def from_config(cls, model: str, config: LLMConfig, *, require_key: bool = True) -> OpenAIBackend:
+        """A backend for ``model`` at the configured endpoint.
+
+        A missing key is an error only for OpenAI's own endpoint, and not at all with
+        ``require_key=False`` (replay runs never send a request).
+        """
+        base_url = (config.base_url or C.OPENAI_BASE_URL).rstrip("/")
+        key = config.api_key_value()
+        if not key:
+            if require_key and base_url == C.OPENAI_BASE_URL:
+                raise MissingAPIKey(
+                    f"no API key for {base_url}: set {C.ENV_API_KEY} (or api_key in the LLM config), "
+                    f"or point {C.ENV_BASE_URL} at a local OpenAI-compatible server"
+                )
+            key = C.PLACEHOLDER_API_KEY
+        return cls(
+            model=model,
+            base_url=base_url,
+            api_key=key,
+            timeout_s=config.timeout_s,
+            max_retries=config.max_retries,
+            backoff_initial_s=config.backoff_initial_s,
+            backoff_max_s=config.backoff_max_s,
+            structured_output=config.structured_output,
+        )
+
+    def _client(self) -> openai.OpenAI:
+        """The SDK client, built once on first use."""
+        if self._sdk is None:
+            import openai
+
+            self._sdk = openai.OpenAI(
+                api_key=self._api_key, base_url=self.base_url, timeout=self.timeout_s, max_retries=0
+            )
+        return self._sdk
+
+    def _backoff_s(self, retry: int, retry_after_s: float | None) -> float:
+        """Sleep before retry number ``retry`` (1-based): exponential with jitter, or the server's ask."""
+        base = retry_after_s if retry_after_s is not None else self.backoff_initial_s * 2 ** (retry - 1)
+        return min(self.backoff_max_s, base) * (1 + C.BACKOFF_JITTER * self._rng.random())
+
+    def _create(self, request: ChatRequest, with_schema: bool) -> Generation:
+        """One HTTP request, no retries."""
+        extra: dict[str, Any] = {}
+        if with_schema and request.schema is not None:
+            extra["response_format"] = {
+                "type": "json_schema",
+                "json_schema": {"name": request.schema_name or "answer", "schema": request.schema, "strict": True},
+            }
+        if request.seed is not None:
+            extra["seed"] = request.seed
+        resp = self._client().chat.completions.create(
+            model=self.model,
+            messages=list(request.messages),  # type: ignore[arg-type]
+            temperature=request.temperature,
+            max_tokens=request.max_tokens,
+            **extra,
+        )
+        text = (resp.choices[0].message.content or "") if resp.choices else ""
+        usage = resp.usage
+        return Generation(
+            text=text,
+            model=resp.model or self.model,
+            prompt_tokens=usage.prompt_tokens if usage else 0,
+            completion_tokens=usage.completion_tokens if usage else 0,
+            attempts=1,
+        )
+
+    def generate(self, request: ChatRequest) -> Generation:
+        """Answer ``request``, retrying transient failures; raises the typed error of the last one."""
+        import openai
+
+        attempts = retries = 0
+        while True:
+            attempts += 1
+            with_schema = request.schema is not None and self.schema_supported
+            retry_after: float | None = None
+            try:
+                gen = self._create(request, with_schema)
+                return Generation(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens, attempts)
+            except openai.BadRequestError as e:
+                if with_schema and self.structured_output is StructuredOutput.AUTO:
+                    log.warning("%s rejected response_format (%s); parsing JSON from text from now on", self.base_url, e)
+                    self.schema_supported = False
+                    continue
+                raise LLMBadRequest(
+                    f"bad request to {self.model}: {e}", status_code=e.status_code, attempts=attempts
+                ) from None
+            except (openai.AuthenticationError, openai.PermissionDeniedError) as e:
+                raise LLMAuthError(
+                    f"{self.base_url} refused the API key ({e.status_code}): check {C.ENV_API_KEY}",
+                    status_code=e.status_code,
+                    attempts=attempts,
+                ) from None
+            except openai.APITimeoutError:
+                error: LLMTransportError = LLMTimeout(
+                    f"{self.model} at {self.base_url} did not answer within {self.timeout_s:g} s", attempts=attempts
+                )
+            except openai.APIConnectionError as e:
+                error = LLMConnectionError(f"cannot reach {self.base_url}: {e}", attempts=attempts)
+            except openai.APIStatusError as e:
+                if e.status_code not in C.RETRYABLE_STATUS:
+                    raise LLMBadRequest(
+                        f"{self.base_url} answered {e.status_code}: {e}", status_code=e.status_code, attempts=attempts
+                    ) from None
+                kind = LLMRateLimited if e.status_code == 429 else LLMServerError
+                error = kind(f"{self.base_url} answered {e.status_code}: {e}", status_code=e.status_code, attempts=attempts)
+                retry_after = _retry_after_s(e.response.headers)
+            retries += 1
+            if retries > self.max_retries:
+                raise error
+            delay = self._backoff_s(retries, retry_after)
+            log.info("retry %d/%d in %.2f s after: %s", retries, self.max_retries, delay, error)
+            self._sleep(delay)

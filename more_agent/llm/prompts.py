@@ -1,0 +1,110 @@
+"""Prompt templates (files in ``prompts/``) and the renderer that turns them into chat messages.
+
+A template file holds ``[[system]]`` / ``[[user]]`` sections with ``string.Template`` fields
+(``$task``); literal dollars are ``$$``. Templates know nothing of the scene graph: the scene text
+comes in as a string from the scene-graph language encoder. The ``*_messages`` helpers fill the
+fields the paper's prompts need (Fig. 3 filtering, Fig. 4 planning, room classification).
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Iterable, Sequence
+from importlib import resources
+from string import Template
+from typing import Protocol
+
+from more_agent.llm.answers import DEFAULT_SKILLS, Skill
+from more_agent.llm.completion import ChatMessage
+
+PROMPT_NAMES = ("room", "filter", "plan")
+HISTORY_LAST_N = 5
+"""The planner sees the last five actions plus all failed ones (paper Sec. III-C)."""
+
+_SECTION = re.compile(r"^\[\[(system|user|assistant)\]\]\s*$", re.M)
+
+
+@functools.cache
+def load_template(name: str) -> tuple[tuple[str, Template], ...]:
+    """The (role, template) sections of ``prompts/NAME.txt``."""
+    if name not in PROMPT_NAMES:
+        raise ValueError(f"unknown prompt {name!r}; prompts: {', '.join(PROMPT_NAMES)}")
+    text = resources.files("more_agent.llm").joinpath("prompts", f"{name}.txt").read_text(encoding="utf-8")
+    parts = _SECTION.split(text)
+    if parts[0].strip():
+        raise ValueError(f"prompt {name!r} has text before its first [[role]] line")
+    return tuple((role, Template(body.strip("\n"))) for role, body in zip(parts[1::2], parts[2::2], strict=True))
+
+
+def prompt_fields(name: str) -> frozenset[str]:
+    """The fields prompt ``name`` needs."""
+    return frozenset(f for _, t in load_template(name) for f in t.get_identifiers())
+
+
+def render_prompt(name: str, **fields: str) -> list[ChatMessage]:
+    """The chat messages of prompt ``name`` with ``fields`` filled in; missing or unknown fields are errors."""
+    needed = prompt_fields(name)
+    if missing := needed - fields.keys():
+        raise ValueError(f"prompt {name!r} needs fields {sorted(missing)}")
+    if extra := fields.keys() - needed:
+        raise ValueError(f"prompt {name!r} has no fields {sorted(extra)}")
+    return [ChatMessage(role=role, content=t.substitute(fields)) for role, t in load_template(name)]  # type: ignore[typeddict-item]
+
+
+class HistoryItem(Protocol):
+    """An executed action as the history shows it (:class:`more_agent.eval.record.ActionRecord` fits)."""
+
+    name: str
+    arguments: list[str]
+    ok: bool
+    feedback: str
+
+
+def skill_api_text(skills: Iterable[Skill]) -> str:
+    """One line per skill: signature and description."""
+    return "\n".join(f"- {s.signature}: {s.description}" for s in skills)
+
+
+def history_text(actions: Sequence[HistoryItem], last_n: int = HISTORY_LAST_N) -> str:
+    """The last ``last_n`` actions plus all earlier failed ones, numbered, in order; 'none' if empty."""
+    first_recent = max(0, len(actions) - last_n)
+    lines = []
+    for i, a in enumerate(actions):
+        if i >= first_recent or not a.ok:
+            outcome = "succeeded" if a.ok else f"failed{': ' + a.feedback if a.feedback else ''}"
+            lines.append(f"{i + 1}. {a.name}({', '.join(a.arguments)}) -> {outcome}")
+    return "\n".join(lines) or "none"
+
+
+def room_messages(objects: Iterable[str], labels: Iterable[str]) -> list[ChatMessage]:
+    """Room classification prompt: objects seen in a region, the room types to choose from."""
+    return render_prompt("room", objects=", ".join(objects) or "none", labels=", ".join(labels))
+
+
+def filter_messages(task: str, scene: str) -> list[ChatMessage]:
+    """Scene filtering prompt (paper Fig. 3) for the full scene text."""
+    return render_prompt("filter", task=task, scene=scene)
+
+
+def plan_messages(
+    *,
+    task: str,
+    scene: str,
+    robot_room: str,
+    held_object: str | None,
+    history: Sequence[HistoryItem],
+    feedback: str,
+    skills: Sequence[Skill] = DEFAULT_SKILLS,
+) -> list[ChatMessage]:
+    """Planning prompt (paper Fig. 4) for the filtered scene text and the robot's state."""
+    return render_prompt(
+        "plan",
+        task=task,
+        scene=scene,
+        skills=skill_api_text(skills),
+        robot_room=robot_room,
+        held_object=held_object or "nothing",
+        history=history_text(history),
+        feedback=feedback or "none",
+    )

@@ -1,0 +1,90 @@
+"""Naming an LLM on the command line (``openai:MODEL``, ``llamacpp:PATH.gguf``) and building its client."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from more_agent.errors import closest_names
+from more_agent.llm.cache import ResponseCache
+from more_agent.llm.client import Backend, ChatClient
+from more_agent.llm.config import CacheMode, LLMConfig
+from more_agent.llm.errors import BadLLMSpec
+
+BACKEND_KINDS = ("openai", "llamacpp")
+SPEC_HELP = "use openai:MODEL (e.g. openai:gpt-4o) or llamacpp:PATH.gguf"
+
+
+class LLMSpec(BaseModel):
+    """Which LLM: a backend kind and a model name (openai) or GGUF file path (llamacpp)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    kind: Literal["openai", "llamacpp"] = Field(description="Backend family.")
+    model: str = Field(description="Model name at the endpoint, or path of the .gguf file.")
+
+    def __str__(self) -> str:
+        return f"{self.kind}:{self.model}"
+
+
+def parse_llm_spec(spec: str) -> LLMSpec:
+    """Parse ``KIND:MODEL``; raises BadLLMSpec saying what is wrong and what to write instead."""
+    kind, sep, model = spec.strip().partition(":")
+    kind, model = kind.strip().lower(), model.strip()
+    if not sep:
+        raise BadLLMSpec(f"LLM spec {spec!r} has no backend prefix; {SPEC_HELP}")
+    if kind not in BACKEND_KINDS:
+        close = closest_names(kind, BACKEND_KINDS)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise BadLLMSpec(f"unknown LLM backend {kind!r} in {spec!r}{hint}; {SPEC_HELP}")
+    if not model:
+        raise BadLLMSpec(f"LLM spec {spec!r} names no model; {SPEC_HELP}")
+    if kind == "llamacpp" and not model.lower().endswith(".gguf"):
+        raise BadLLMSpec(f"llamacpp model {model!r} is not a .gguf file; {SPEC_HELP}")
+    return LLMSpec(kind=kind, model=model)  # type: ignore[arg-type]
+
+
+def configured_llm(config: LLMConfig, cli_spec: str | None = None) -> LLMSpec | None:
+    """The LLM to use: ``--llm`` if given, else the config's/``MORE_AGENT_LLM``'s, else None (run the oracle)."""
+    spec = cli_spec or config.llm
+    return parse_llm_spec(spec) if spec else None
+
+
+def llm_configured(config: LLMConfig, cli_spec: str | None = None) -> bool:
+    """Whether any LLM is configured; False means the default planner is the oracle."""
+    return bool(cli_spec or config.llm)
+
+
+def room_spec(spec: LLMSpec, config: LLMConfig) -> LLMSpec:
+    """The LLM for room classification: ``config.room_model`` on the same endpoint (openai), else ``spec``."""
+    if spec.kind == "openai" and config.room_model:
+        return LLMSpec(kind="openai", model=config.room_model)
+    return spec
+
+
+def make_backend(spec: LLMSpec, config: LLMConfig) -> Backend:
+    """The backend for ``spec`` (imports the backend module only now)."""
+    if spec.kind == "openai":
+        from more_agent.llm.openai_backend import OpenAIBackend
+
+        return OpenAIBackend.from_config(spec.model, config, require_key=config.cache_mode is not CacheMode.REPLAY)
+    from more_agent.llm.llamacpp_backend import LlamaCppBackend
+
+    return LlamaCppBackend.from_config(Path(spec.model).expanduser(), config)
+
+
+def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:
+    """A ready client for ``spec`` with the configured cache mode; raises LLMConfigError subclasses."""
+    spec = parse_llm_spec(spec) if isinstance(spec, str) else spec
+    cache = ResponseCache(config.cache_path) if config.cache_mode is not CacheMode.OFF else None
+    return ChatClient(
+        make_backend(spec, config),
+        cache=cache,
+        cache_mode=config.cache_mode,
+        temperature=config.temperature,
+        max_tokens=config.max_tokens,
+        seed=config.seed,
+        prices=config.prices,
+    )

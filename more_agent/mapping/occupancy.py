@@ -1,0 +1,226 @@
+"""Posed depth + semantics -> world points -> 3D voxel grid -> 2D BEV occupancy.
+
+``VoxelMap`` keeps, per voxel, the semantic class and instance id of the last point that fell in
+it. Each frame first clears the voxels its rays pass through (so moved objects and opened doors
+disappear), then writes the frame's hits. The BEV takes the highest occupied voxel per column
+below ``bev_max_height_m`` (it may lie below the ground, e.g. a pool): a free-space class there
+(floor, carpet, lawn, driveway) makes the cell FREE, any other class OCCUPIED, none UNKNOWN.
+Voxels of free-space classes are never cleared by passing rays: grazing rays would otherwise
+erase the ground they skim. Depth is z-depth in the OpenCV camera frame (x right, y down, z fwd).
+Grid layout: ``grid[ix, iy]``, cell centre ``origin_xy + (ix + 0.5, iy + 0.5) * resolution_m``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numba
+import numpy as np
+
+UNKNOWN, FREE, OCCUPIED = 0, 1, 2
+"""BEV cell values (also used by the synthetic benchmark maps)."""
+
+_MAX_CLASSES = 65535
+
+
+def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """World points (N, 3) of the finite depth pixels and their flat pixel indices (N,)."""
+    h, w = depth.shape
+    v, u = np.mgrid[0:h, 0:w]
+    valid = np.isfinite(depth).ravel()
+    d = depth.ravel()[valid]
+    x = (u.ravel()[valid] + 0.5 - K[0, 2]) / K[0, 0] * d
+    y = (v.ravel()[valid] + 0.5 - K[1, 2]) / K[1, 1] * d
+    cam = np.stack([x, y, d], axis=1)
+    return cam @ T_world_cam[:3, :3].T + T_world_cam[:3, 3], np.flatnonzero(valid)
+
+
+@numba.njit(cache=True)
+def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lut):
+    """Clear the non-free-space voxels that rays pass through before their hit (or max range)."""
+    h, w = depth.shape
+    nx, ny, nz = cls.shape
+    for v in range(stride // 2, h, stride):
+        for u in range(stride // 2, w, stride):
+            a = (u + 0.5 - intr[2]) / intr[0]
+            b = (v + 0.5 - intr[3]) / intr[1]
+            norm = np.sqrt(a * a + b * b + 1.0)
+            d = depth[v, u]
+            length = max_range if not np.isfinite(d) else min(d * norm, max_range)
+            dx = (rot[0, 0] * a + rot[0, 1] * b + rot[0, 2]) / norm
+            dy = (rot[1, 0] * a + rot[1, 1] * b + rot[1, 2]) / norm
+            dz = (rot[2, 0] * a + rot[2, 1] * b + rot[2, 2]) / norm
+            t = 0.0
+            while t < length - res:
+                ix = int(np.floor((trans[0] + t * dx - origin[0]) / res))
+                iy = int(np.floor((trans[1] + t * dy - origin[1]) / res))
+                iz = int(np.floor((trans[2] + t * dz - origin[2]) / res))
+                if 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
+                    c = cls[ix, iy, iz]
+                    if c != 0 and not free_lut[c - 1]:
+                        cls[ix, iy, iz] = 0
+                t += res
+
+
+@numba.njit(cache=True)
+def _insert(depth, semantic, instance, use, intr, rot, trans, cls, inst, origin, res, max_range):
+    """Write every valid pixel's hit into the grid (class + 1, instance id)."""
+    h, w = depth.shape
+    nx, ny, nz = cls.shape
+    for v in range(h):
+        for u in range(w):
+            d = depth[v, u]
+            if not use[v, u] or not np.isfinite(d):
+                continue
+            a = (u + 0.5 - intr[2]) / intr[0] * d
+            b = (v + 0.5 - intr[3]) / intr[1] * d
+            if a * a + b * b + d * d > max_range * max_range:
+                continue
+            px = rot[0, 0] * a + rot[0, 1] * b + rot[0, 2] * d + trans[0]
+            py = rot[1, 0] * a + rot[1, 1] * b + rot[1, 2] * d + trans[1]
+            pz = rot[2, 0] * a + rot[2, 1] * b + rot[2, 2] * d + trans[2]
+            ix = int(np.floor((px - origin[0]) / res))
+            iy = int(np.floor((py - origin[1]) / res))
+            iz = int(np.floor((pz - origin[2]) / res))
+            if 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
+                cls[ix, iy, iz] = semantic[v, u] + 1
+                inst[ix, iy, iz] = instance[v, u]
+
+
+@numba.njit(cache=True)
+def _update_top(cls, top, x0, x1, y0, y1, top_level):
+    """Recompute the BEV class (highest occupied voxel at or below ``top_level``) in a window."""
+    for ix in range(x0, x1):
+        for iy in range(y0, y1):
+            top[ix, iy] = -1
+            for k in range(top_level, -1, -1):
+                c = cls[ix, iy, k]
+                if c != 0:
+                    top[ix, iy] = c - 1
+                    break
+
+
+class VoxelMap:
+    """Growing dense voxel grid of semantic class and instance id, with its BEV kept up to date."""
+
+    def __init__(
+        self,
+        *,
+        free_class_ids: Iterable[int],
+        resolution_m: float = 0.075,
+        z_min_m: float = -1.0,
+        z_max_m: float = 3.0,
+        bev_max_height_m: float = 2.0,
+        max_range_m: float = 5.0,
+        carve_stride_px: int = 2,
+        initial_extent_m: float = 20.0,
+    ) -> None:
+        self.resolution_m = resolution_m
+        self.max_range_m = max_range_m
+        self.carve_stride_px = carve_stride_px
+        self.initial_extent_m = initial_extent_m
+        self._free_lut = np.zeros(_MAX_CLASSES + 1, dtype=np.bool_)
+        self._free_lut[list(free_class_ids)] = True
+        self._nz = int(np.ceil((z_max_m - z_min_m) / resolution_m))
+        self._z_min = z_min_m
+        self._top_level = min(self._nz - 1, int(np.ceil((bev_max_height_m - z_min_m) / resolution_m - 0.5)) - 1)
+        self.origin_xy = np.zeros(2)
+        self.cls = np.zeros((0, 0, self._nz), dtype=np.uint16)
+        self.inst = np.zeros((0, 0, self._nz), dtype=np.int32)
+        self.top_class = np.full((0, 0), -1, dtype=np.int32)
+        """BEV: semantic class of the highest occupied voxel per column, -1 where none."""
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.top_class.shape
+
+    def _ensure_covers(self, lo: np.ndarray, hi: np.ndarray) -> None:
+        """Grow the grid (whole cells, existing content kept) so that [lo, hi] in xy lies inside."""
+        res = self.resolution_m
+        if self.cls.shape[0] == 0:
+            half = max(self.initial_extent_m / 2, float(np.max(hi - lo)) / 2 + res)
+            centre = (lo + hi) / 2
+            self.origin_xy = np.round((centre - half) / res) * res
+            n = int(np.ceil(2 * half / res))
+            self.cls = np.zeros((n, n, self._nz), dtype=np.uint16)
+            self.inst = np.zeros((n, n, self._nz), dtype=np.int32)
+            self.top_class = np.full((n, n), -1, dtype=np.int32)
+            return
+        size = np.array(self.shape)
+        low = np.floor((lo - self.origin_xy) / res).astype(int)
+        high = np.ceil((hi - self.origin_xy) / res).astype(int)
+        if (low >= 0).all() and (high <= size).all():
+            return
+        margin = int(np.ceil(self.initial_extent_m / 2 / res))
+        pad_lo = np.where(low < 0, -low + margin, 0)
+        pad_hi = np.where(high > size, high - size + margin, 0)
+        pads = ((pad_lo[0], pad_hi[0]), (pad_lo[1], pad_hi[1]))
+        self.cls = np.pad(self.cls, (*pads, (0, 0)))
+        self.inst = np.pad(self.inst, (*pads, (0, 0)))
+        self.top_class = np.pad(self.top_class, pads, constant_values=-1)
+        self.origin_xy = self.origin_xy - pad_lo * res
+
+    def integrate(
+        self,
+        depth: np.ndarray,
+        semantic: np.ndarray,
+        instance: np.ndarray,
+        K: np.ndarray,
+        T_world_cam: np.ndarray,
+        *,
+        ignore_instances: Iterable[int] = (),
+    ) -> None:
+        """Fuse one frame: clear traversed voxels, write hits (except of ``ignore_instances``,
+        e.g. held objects), refresh the BEV within sensor range of the camera."""
+        rot = np.ascontiguousarray(T_world_cam[:3, :3], dtype=np.float64)
+        trans = np.ascontiguousarray(T_world_cam[:3, 3], dtype=np.float64)
+        r = self.max_range_m
+        self._ensure_covers(trans[:2] - r, trans[:2] + r)
+        intr = np.array([K[0, 0], K[1, 1], K[0, 2], K[1, 2]], dtype=np.float64)
+        origin = np.array([self.origin_xy[0], self.origin_xy[1], self._z_min])
+        depth = np.ascontiguousarray(depth, dtype=np.float32)
+        ignore = np.fromiter(ignore_instances, dtype=np.int64)
+        use = ~np.isin(instance, ignore) if ignore.size else np.ones(depth.shape, dtype=np.bool_)
+        res = self.resolution_m
+        _carve(depth, intr, rot, trans, self.cls, origin, res, r, self.carve_stride_px, self._free_lut)
+        _insert(depth, semantic.astype(np.int32, copy=False), instance.astype(np.int32, copy=False), use,
+                intr, rot, trans, self.cls, self.inst, origin, res, r)
+        lo = np.maximum(np.floor((trans[:2] - r - self.origin_xy) / res).astype(int), 0)
+        hi = np.minimum(np.ceil((trans[:2] + r - self.origin_xy) / res).astype(int) + 1, self.shape)
+        _update_top(self.cls, self.top_class, lo[0], hi[0], lo[1], hi[1], self._top_level)
+
+    def occupancy(self) -> np.ndarray:
+        """BEV grid (int8): UNKNOWN, FREE (top voxel of a free-space class) or OCCUPIED."""
+        out = np.full(self.shape, UNKNOWN, dtype=np.int8)
+        seen = self.top_class >= 0
+        free = np.zeros(self.shape, dtype=bool)
+        free[seen] = self._free_lut[self.top_class[seen]]
+        out[seen] = OCCUPIED
+        out[free] = FREE
+        return out
+
+    def instance_voxels(self) -> dict[int, np.ndarray]:
+        """World coordinates (k, 3) of the occupied voxel centres of every instance id > 0."""
+        flat = np.flatnonzero((self.inst > 0) & (self.cls > 0))
+        if flat.size == 0:
+            return {}
+        ids = self.inst.ravel()[flat]
+        order = np.argsort(ids, kind="stable")
+        flat, ids = flat[order], ids[order]
+        ix, iy, iz = np.unravel_index(flat, self.inst.shape)
+        res = self.resolution_m
+        pts = np.stack([self.origin_xy[0] + (ix + 0.5) * res, self.origin_xy[1] + (iy + 0.5) * res,
+                        self._z_min + (iz + 0.5) * res], axis=1)
+        uniq, starts = np.unique(ids, return_index=True)
+        return {int(i): p for i, p in zip(uniq, np.split(pts, starts[1:]))}
+
+    def clear_instance(self, instance_id: int) -> None:
+        """Remove every voxel of one instance (e.g. when it is picked up) and refresh the BEV."""
+        hit = self.inst == instance_id
+        if not hit.any():
+            return
+        self.cls[hit] = 0
+        self.inst[hit] = 0
+        cols = hit.any(axis=2)
+        xs, ys = np.nonzero(cols)
+        _update_top(self.cls, self.top_class, xs.min(), xs.max() + 1, ys.min(), ys.max() + 1, self._top_level)

@@ -1,0 +1,336 @@
+"""Magic actions on the world: navigate, open, close, grasp, place inside / on top.
+
+They follow the paper (S.3) and OmniGibson's symbolic primitives: grasp needs an empty hand;
+open / close need an empty hand and an openable object in the other state; placing inside needs
+the target open. Every manipulation needs the object observable (not shut inside a closed
+container) and within ``REACH_M`` of the robot base, measured to the object's footprint. Each
+failure returns a typed ``FailureReason`` and the short feedback a planner sees ("hand is full",
+"must open fridge A first").
+
+``navigate_to`` samples base poses on a circle around the object (radius = footprint half-diagonal
+plus ``CLEARANCE_M``), falls back to a ring around its supporting furniture, keeps the free poses
+within reach and drives the ground-truth shortest path to the nearest one; it counts low-level
+steps as 7.5 cm forward moves and turns of at most 35 degrees, and ends facing the object.
+``go_to_and`` chains navigation and one manipulation as the paper's subpolicies do.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
+from more_agent.sim.world import World, WorldObject
+
+REACH_M = 1.5
+"""Largest horizontal distance from the robot base to an object's footprint for a manipulation."""
+
+CLEARANCE_M = 0.45
+"""Distance added to an object's half-diagonal for the navigation circle."""
+
+RING_OFFSETS_M = (0.35, 0.6, 0.9)
+"""Offsets from a support's footprint edge of the fallback rings of navigation poses."""
+
+POSES_PER_RING = 32
+"""Candidate base poses sampled per circle or ring."""
+
+FORWARD_STEP_M = 0.075
+"""Length of one low-level forward move (paper S.3)."""
+
+MAX_TURN_RAD = math.radians(35)
+"""Largest low-level turn (paper S.3)."""
+
+
+class FailureReason(str, Enum):
+    """Why a magic action failed."""
+
+    UNKNOWN_OBJECT = "unknown_object"
+    HIDDEN = "hidden"
+    NOT_REACHABLE = "not_reachable"
+    PATH_BLOCKED_BY_DOOR = "path_blocked_by_door"
+    TOO_FAR = "too_far"
+    HAND_FULL = "hand_full"
+    HAND_EMPTY = "hand_empty"
+    NOT_OPENABLE = "not_openable"
+    ALREADY_OPEN = "already_open"
+    ALREADY_CLOSED = "already_closed"
+    NOT_GRASPABLE = "not_graspable"
+    TARGET_CLOSED = "target_closed"
+    INVALID_TARGET = "invalid_target"
+
+
+@dataclass(frozen=True)
+class ActionResult:
+    """The outcome of one action: success, typed reason and feedback, and the motion it took."""
+
+    ok: bool
+    reason: FailureReason | None
+    feedback: str
+    low_level_steps: int = 0
+    path: list[XY] = field(default_factory=list)
+    """Robot base positions visited, start and end included, when the robot moved."""
+    blocking: str | None = None
+    """The closed door in the way, when ``reason`` is PATH_BLOCKED_BY_DOOR."""
+
+
+def _ok(feedback: str, steps: int = 1, path: list[XY] | None = None) -> ActionResult:
+    return ActionResult(ok=True, reason=None, feedback=feedback, low_level_steps=steps, path=path or [])
+
+
+def _fail(reason: FailureReason, feedback: str, blocking: str | None = None) -> ActionResult:
+    return ActionResult(ok=False, reason=reason, feedback=feedback, blocking=blocking)
+
+
+def _label(obj: WorldObject) -> str:
+    return obj.label or obj.name
+
+
+def _footprint(obj: WorldObject) -> tuple[float, float, float, float]:
+    lo, hi = obj.box()
+    return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+
+def distance_to_footprint(world: World, name: str) -> float:
+    """Horizontal distance from the robot base to the footprint of ``name`` (0 when above it)."""
+    x0, y0, x1, y1 = _footprint(world.get(name))
+    dx = max(x0 - world.robot.x, 0.0, world.robot.x - x1)
+    dy = max(y0 - world.robot.y, 0.0, world.robot.y - y1)
+    return math.hypot(dx, dy)
+
+
+def _check_target(world: World, name: str) -> WorldObject | ActionResult:
+    """The object, or the failure for an unknown, held-away or hidden one."""
+    if name not in world.objects:
+        return _fail(FailureReason.UNKNOWN_OBJECT, f"there is no {name}")
+    obj = world.get(name)
+    hider = world.enclosing_closed_container(name)
+    if hider is not None:
+        return _fail(FailureReason.HIDDEN, f"{_label(obj)} is inside closed {_label(hider)}; must open {_label(hider)} first")
+    return obj
+
+
+def _check_reach(world: World, obj: WorldObject) -> ActionResult | None:
+    if world.robot.held == obj.name or distance_to_footprint(world, obj.name) <= REACH_M:
+        return None
+    return _fail(FailureReason.TOO_FAR, f"{_label(obj)} is too far away")
+
+
+# -- navigation ---------------------------------------------------------------------------------
+
+
+def _anchor(world: World, obj: WorldObject) -> WorldObject:
+    """The furniture (or floor) an item ultimately rests on; the object itself otherwise."""
+    chain = world.ancestors(obj.name)
+    fixed = [parent for parent, _ in chain if not parent.movable]
+    return fixed[0] if fixed else obj
+
+
+def _ring(x0: float, y0: float, x1: float, y1: float, offset: float) -> list[XY]:
+    """Points at ``offset`` from a rectangle's edge, evenly spread around it."""
+    cx, cy, hx, hy = (x0 + x1) / 2, (y0 + y1) / 2, (x1 - x0) / 2 + offset, (y1 - y0) / 2 + offset
+    angles = np.linspace(0, 2 * np.pi, POSES_PER_RING, endpoint=False)
+    # Project directions onto the offset rectangle: a rounded-enough ring around elongated furniture.
+    scale = 1.0 / np.maximum(np.abs(np.cos(angles)) / hx, np.abs(np.sin(angles)) / hy)
+    return [(float(cx + s * math.cos(a)), float(cy + s * math.sin(a))) for a, s in zip(angles, scale)]
+
+
+def candidate_poses(world: World, name: str) -> list[list[XY]]:
+    """Base positions to try around an object, in rounds: the paper's circle first, then rings around its support."""
+    obj = world.get(name)
+    x0, y0, x1, y1 = _footprint(obj)
+    radius = math.hypot(x1 - x0, y1 - y0) / 2 + CLEARANCE_M
+    angles = np.linspace(0, 2 * np.pi, POSES_PER_RING, endpoint=False)
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    rounds = [[(float(cx + radius * math.cos(a)), float(cy + radius * math.sin(a))) for a in angles]]
+    anchor = _anchor(world, obj)
+    if anchor.kind != "floor":
+        rounds += [_ring(*_footprint(anchor), offset) for offset in RING_OFFSETS_M]
+    return rounds
+
+
+def _heading(a: XY, b: XY) -> float:
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def _turns(delta: float) -> int:
+    delta = abs(math.atan2(math.sin(delta), math.cos(delta)))
+    return math.ceil(delta / MAX_TURN_RAD - 1e-9)
+
+
+def count_low_level_steps(yaw: float, waypoints: list[XY], final_yaw: float) -> int:
+    """Forward moves of 7.5 cm plus turns of at most 35 degrees to follow ``waypoints`` and end at ``final_yaw``."""
+    steps = 0
+    for a, b in zip(waypoints, waypoints[1:]):
+        length = math.dist(a, b)
+        if length < 1e-9:
+            continue
+        heading = _heading(a, b)
+        steps += _turns(heading - yaw) + math.ceil(length / FORWARD_STEP_M - 1e-9)
+        yaw = heading
+    return steps + _turns(final_yaw - yaw)
+
+
+def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:
+    """Drive to the nearest free pose within reach of ``name`` and face it.
+
+    Fails with NOT_REACHABLE when no such pose can be reached, or PATH_BLOCKED_BY_DOOR naming the
+    closed door on the way (``ActionResult.blocking``) when opening it would make one reachable.
+    """
+    checked = _check_target(world, name)
+    if isinstance(checked, ActionResult):
+        return checked
+    obj = checked
+    if world.robot.held == name:
+        return _fail(FailureReason.INVALID_TARGET, f"already holding {_label(obj)}")
+    grid = nav_grid(world, config)
+    start = (world.robot.x, world.robot.y)
+    x0, y0, x1, y1 = _footprint(obj)
+    center = ((x0 + x1) / 2, (y0 + y1) / 2)
+    any_candidates: list[XY] = []
+    for poses in candidate_poses(world, name):
+        near = [p for p in poses if _point_to_box(p, (x0, y0, x1, y1)) <= REACH_M]
+        any_candidates += near
+        path = shortest_path(grid, start, near)
+        if path.found:
+            goal = path.waypoints[-1]
+            final_yaw = _heading(goal, center)
+            steps = count_low_level_steps(world.robot.yaw, path.waypoints, final_yaw)
+            world.set_robot_pose(goal[0], goal[1], final_yaw)
+            return _ok(f"reached {_label(obj)}", steps=steps, path=path.waypoints)
+    door = blocking_door(world, start, any_candidates, config)
+    if door is not None:
+        return _fail(
+            FailureReason.PATH_BLOCKED_BY_DOOR, f"the way to {_label(obj)} is blocked by closed {_label(world.get(door))}",
+            blocking=door,
+        )
+    return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {_label(obj)}")
+
+
+def _point_to_box(p: XY, box: tuple[float, float, float, float]) -> float:
+    x0, y0, x1, y1 = box
+    return math.hypot(max(x0 - p[0], 0.0, p[0] - x1), max(y0 - p[1], 0.0, p[1] - y1))
+
+
+# -- manipulation -------------------------------------------------------------------------------
+
+
+def _set_open(world: World, name: str, want_open: bool) -> ActionResult:
+    checked = _check_target(world, name)
+    if isinstance(checked, ActionResult):
+        return checked
+    obj = checked
+    verb = "open" if want_open else "close"
+    if world.robot.held is not None:
+        return _fail(FailureReason.HAND_FULL, f"hand is full; cannot {verb} {_label(obj)}")
+    if not obj.openable:
+        return _fail(FailureReason.NOT_OPENABLE, f"{_label(obj)} cannot be opened or closed")
+    if obj.is_open == want_open:
+        reason = FailureReason.ALREADY_OPEN if want_open else FailureReason.ALREADY_CLOSED
+        return _fail(reason, f"{_label(obj)} is already {'open' if want_open else 'closed'}")
+    far = _check_reach(world, obj)
+    if far is not None:
+        return far
+    world.set_open(name, want_open)
+    return _ok(f"{'opened' if want_open else 'closed'} {_label(obj)}")
+
+
+def open_(world: World, name: str) -> ActionResult:
+    """Open a closed openable object (container or door) within reach, with an empty hand."""
+    return _set_open(world, name, True)
+
+
+def close(world: World, name: str) -> ActionResult:
+    """Close an open openable object within reach, with an empty hand."""
+    return _set_open(world, name, False)
+
+
+def grasp(world: World, name: str) -> ActionResult:
+    """Pick up a movable, observable item within reach, with an empty hand (what rests on / in it comes along)."""
+    checked = _check_target(world, name)
+    if isinstance(checked, ActionResult):
+        return checked
+    obj = checked
+    if world.robot.held is not None:
+        return _fail(FailureReason.HAND_FULL, f"hand is full; holding {_label(world.get(world.robot.held))}")
+    if not obj.movable:
+        return _fail(FailureReason.NOT_GRASPABLE, f"{_label(obj)} cannot be picked up")
+    far = _check_reach(world, obj)
+    if far is not None:
+        return far
+    world.pick(name)
+    world.set_robot_pose(world.robot.x, world.robot.y, world.robot.yaw)  # the item moves to the gripper
+    return _ok(f"grasped {_label(obj)}")
+
+
+def _place(world: World, name: str, relation: str) -> ActionResult:
+    held = world.robot.held
+    if held is None:
+        return _fail(FailureReason.HAND_EMPTY, "hand is empty")
+    checked = _check_target(world, name)
+    if isinstance(checked, ActionResult):
+        return checked
+    target = checked
+    item = world.get(held)
+    if target.kind == "door" or name == held or any(d.name == name for d in world.descendants(held)):
+        return _fail(FailureReason.INVALID_TARGET, f"cannot place {_label(item)} {relation} {_label(target)}")
+    if relation == "inside" and target.kind == "floor":
+        return _fail(FailureReason.INVALID_TARGET, f"cannot place {_label(item)} inside the floor")
+    if relation == "inside" and target.openable and not target.is_open:
+        return _fail(FailureReason.TARGET_CLOSED, f"must open {_label(target)} first")
+    far = _check_reach(world, target)
+    if far is not None:
+        return far
+    if target.kind == "floor":
+        ahead = (world.robot.x + 0.4 * math.cos(world.robot.yaw), world.robot.y + 0.4 * math.sin(world.robot.yaw))
+        fx0, fy0, fx1, fy1 = _footprint(target)
+        world.place(held, name, "ontop")
+        world.place_on_floor_at(held, name, (min(max(ahead[0], fx0), fx1), min(max(ahead[1], fy0), fy1)))
+    else:
+        world.place(held, name, relation)  # type: ignore[arg-type]
+    return _ok(f"placed {_label(item)} {'inside' if relation == 'inside' else 'on'} {_label(target)}")
+
+
+def place_inside(world: World, name: str) -> ActionResult:
+    """Put the held item inside ``name``, which must be open if it is openable."""
+    return _place(world, name, "inside")
+
+
+def place_ontop(world: World, name: str) -> ActionResult:
+    """Put the held item on top of ``name`` (a floor: just in front of the robot)."""
+    return _place(world, name, "ontop")
+
+
+MANIPULATIONS: dict[str, Callable[[World, str], ActionResult]] = {
+    "open": open_,
+    "close": close,
+    "grasp": grasp,
+    "place_inside": place_inside,
+    "place_ontop": place_ontop,
+}
+"""Magic manipulations by name; each takes the world and one object name."""
+
+
+def go_to_and(world: World, verb: str, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:
+    """The paper's ``go_to_and_<verb>`` subpolicy: navigate next to ``name`` unless within reach, then act.
+
+    Preconditions that do not depend on position are checked before moving, so a doomed action
+    (hand full, target closed, ...) costs no motion. Steps and path of both parts are summed.
+    """
+    if verb not in MANIPULATIONS:
+        raise ValueError(f"unknown manipulation {verb!r}; known: {', '.join(MANIPULATIONS)}")
+    act = MANIPULATIONS[verb]
+    trial = act(world, name)
+    if trial.ok or trial.reason is not FailureReason.TOO_FAR:
+        return trial
+    nav = navigate_to(world, name, config)
+    if not nav.ok:
+        return nav
+    result = act(world, name)
+    return ActionResult(
+        ok=result.ok, reason=result.reason, feedback=result.feedback,
+        low_level_steps=nav.low_level_steps + result.low_level_steps, path=nav.path, blocking=result.blocking,
+    )

@@ -1,0 +1,114 @@
+"""Goal evaluation: bddl evaluates a task's goal through our backend on the current world.
+
+``GoalChecker`` compiles the goal once per task instance with ``bddl.activity.get_goal_conditions``
+and expands it into bddl's ground options (``get_ground_goal_state_options``: each option is a
+conjunction of ground literals that satisfies the goal; bddl keeps at most 20). ``check(world)``
+reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
+option closest to being met, each conjunct's status: that option's satisfied share is the task
+progress (TP). The oracle reads the same option as structured ``Literal``s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_ground_goal_state_options
+from bddl.condition_evaluation import evaluate_state
+
+from more_agent.eval.record import GoalCondition
+from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
+from more_agent.sim.world import World
+
+if TYPE_CHECKING:
+    from more_agent.sim.instantiate import TaskInstance
+
+
+@dataclass(frozen=True)
+class Literal:
+    """One ground goal literal over world object names ('robot' for the agent)."""
+
+    predicate: str
+    args: tuple[str, ...]
+    negated: bool = False
+
+    @property
+    def text(self) -> str:
+        """BDDL form with world names, e.g. '(inside apple_1 fridge_0)' or '(not (open fridge_0))'."""
+        atom = f"({' '.join((self.predicate, *self.args))})"
+        return f"(not {atom})" if self.negated else atom
+
+
+@dataclass(frozen=True)
+class GoalStatus:
+    """The goal in one world state."""
+
+    all_met: bool
+    """The whole goal holds (bddl's evaluation of the compiled goal)."""
+    progress: float
+    """Satisfied share of the best ground option's conjuncts (1.0 when all_met)."""
+    conditions: list[GoalCondition]
+    """The best option's conjuncts with their status."""
+    option_index: int
+    """Index of the best option (see ``GoalChecker.ground_literals``)."""
+
+
+def literal_from_parsed(parsed: list[Any], scope: dict[str, ScopeObject]) -> Literal:
+    """A bddl ground literal (``['not', ['open', 'fridge.n.01_1']]``) over world names."""
+    negated = parsed[0] == "not"
+    atom = parsed[1] if negated else parsed
+    args = tuple(scope[a.lstrip("?")].world_name for a in atom[1:])
+    return Literal(predicate=atom[0], args=args, negated=negated)
+
+
+class GoalChecker:
+    """Evaluates one task instance's goal on a world (the instance's own, or another of the same task)."""
+
+    def __init__(self, instance: TaskInstance) -> None:
+        self.backend = WorldBackend(instance.world)
+        self.scope = instance.scope_objects()
+        conds = instance.definition.conditions
+        goal = get_goal_conditions(conds, self.backend, dict(self.scope))
+        if not goal:
+            raise ValueError(f"task {instance.task} has an empty goal")
+        self._goal = goal
+        self._options = get_ground_goal_state_options(conds, self.backend, dict(self.scope), goal)
+        self._literals = [[literal_from_parsed(head.body, self.scope) for head in opt] for opt in self._options]
+
+    @property
+    def n_options(self) -> int:
+        """Number of ground options bddl produced (at most 20)."""
+        return len(self._options)
+
+    def ground_literals(self, option_index: int) -> list[Literal]:
+        """The conjuncts of one ground option, as structured literals over world names."""
+        return list(self._literals[option_index])
+
+    def check(self, world: World | None = None) -> GoalStatus:
+        """Goal status in ``world`` (default: the world the instance was built in)."""
+        if world is not None:
+            self.backend.world = world
+        all_met, _ = evaluate_goal_conditions(self._goal)
+        best_index, best_sat = 0, []
+        best_fraction = -1.0
+        for i, option in enumerate(self._options):
+            _, result = evaluate_state(option)
+            fraction = len(result["satisfied"]) / len(option)
+            if fraction > best_fraction:
+                best_index, best_fraction, best_sat = i, fraction, result["satisfied"]
+        satisfied = set(best_sat)
+        conditions = [
+            GoalCondition(text=lit.text, satisfied=j in satisfied, objects=list(lit.args))
+            for j, lit in enumerate(self._literals[best_index])
+        ]
+        return GoalStatus(
+            all_met=bool(all_met),
+            progress=1.0 if all_met else best_fraction,
+            conditions=conditions,
+            option_index=best_index,
+        )
+
+    @property
+    def unsupported_predicates(self) -> set[str]:
+        """Goal predicates the backend cannot evaluate (they always read False), seen so far."""
+        return set(self.backend.unsupported)

@@ -1,0 +1,396 @@
+"""Task instantiation: put a BEHAVIOR-1K activity into a world built from a scene.
+
+Steps (all deterministic for a given task, scene and seed):
+1. Scopes bound by ``inroom`` literals take existing scene objects: per room type, the first room
+   of that type (scene order) where every such scope gets its own piece of furniture of a matching
+   category (bipartite matching); ``floor.n.01_k`` takes that room's floor.
+2. ``agent.n.01_1`` stands for the robot; substances and ``future`` objects are virtual scopes.
+3. Every other scope becomes a new item: category from the synset (the synset's own category when
+   it has one, else one drawn with the seed), size from the catalogue, name from the scope
+   ('apple.n.01_1' -> 'apple_1').
+4. Placement literals run supports first (topological order): ``ontop``/``inside`` rest the item on
+   / in its support (on a floor: at a free spot sampled against furniture, walls, doors and other
+   floor items); ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
+   ``touching`` on the floor beside the other object, or on the same support when that object is
+   not on a floor. Openable containers that receive items are closed unless an ``open`` literal
+   says otherwise; then ``open`` / ``not open`` literals set articulation.
+5. The robot stands at a free spot of the room of its ``ontop agent floor`` literal.
+6. Every supported init literal is evaluated through our bddl backend; a false one raises
+   ``InstantiationError`` naming it. Literals that do not apply to rearrangement (cooked,
+   covered, filled, ...) and literals over virtual scopes are kept in ``unsupported_literals``.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+from bddl.condition_evaluation import compile_state
+
+from more_agent.errors import UserError
+from more_agent.sim import catalog
+from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
+from more_agent.sim.scene import Scene
+from more_agent.sim.tasks import TaskDefinition, describe_goal, load_task, scope_synset, suitable_scenes
+from more_agent.sim.world import World, WorldObject
+
+PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
+"""Init predicates that decide where an item rests, in order of preference."""
+
+ROBOT_CLEARANCE_M = 0.35
+"""Radius kept free of furniture around the robot's start pose."""
+
+FLOOR_MARGIN_M = 0.1
+"""Gap kept between a floor item and walls, furniture and other floor items."""
+
+DOOR_KEEPOUT_M = 0.6
+"""Floor items stay this far from door openings so doors stay passable."""
+
+SAMPLE_TRIES = 400
+
+ParsedLiteral = list
+
+
+class InstantiationError(UserError):
+    """A task cannot be put into a scene; the message names the literal or requirement that failed."""
+
+    def __init__(self, message: str, literal: str | None = None) -> None:
+        super().__init__(message)
+        self.literal = literal
+
+
+@dataclass
+class TaskInstance:
+    """A task put into a world: what planners, actions and goal checks work on."""
+
+    task: str
+    scene: str
+    seed: int
+    world: World
+    description: str
+    scope: dict[str, str]
+    """Scope name -> world object name ('robot' for the agent; virtual scopes map to themselves)."""
+    virtual_scopes: list[str]
+    """Scopes the world does not model (substances, future objects)."""
+    unsupported_literals: list[str]
+    """Init literals (BDDL form, scope names) not applied because rearrangement does not model them."""
+    timings: dict[str, float]
+    definition: TaskDefinition = field(repr=False)
+
+    def scope_objects(self) -> dict[str, ScopeObject]:
+        """The filled bddl scope: every entry a ``ScopeObject``."""
+        virtual = set(self.virtual_scopes)
+        return {
+            s: ScopeObject(s, name, "agent" if name == ROBOT_NAME else "virtual" if s in virtual else "object")
+            for s, name in self.scope.items()
+        }
+
+    def label(self, scope: str) -> str:
+        """Readable name of a scope's object: its label ('apple A'), a floor's room or 'the robot'."""
+        return _readable(self.world, self.scope[scope])
+
+
+def instantiate(task: str, scene: str | None = None, seed: int = 0) -> TaskInstance:
+    """Instantiate ``task`` in a scene by name (default: its first suitable scene), generated with ``seed``."""
+    t0 = time.perf_counter()
+    definition = load_task(task)
+    t_parse = time.perf_counter() - t0
+    scenes = suitable_scenes(task)
+    if scene is None:
+        if not scenes:
+            raise InstantiationError(f"no BEHAVIOR-1K scene suits task {task!r} (its inroom requirements match none)")
+        scene = scenes[0]
+    from more_agent.sim.scenes import get_scene
+
+    t1 = time.perf_counter()
+    scene_obj = get_scene(scene, seed)
+    t_scene = time.perf_counter() - t1
+    instance = instantiate_in_scene(definition, scene_obj, seed)
+    instance.timings.update(parse=t_parse, scene=t_scene, total=time.perf_counter() - t0)
+    return instance
+
+
+def instantiate_in_scene(definition: TaskDefinition | str, scene: Scene, seed: int = 0) -> TaskInstance:
+    """Instantiate a task in a given ``Scene`` object (hand-built scenes included)."""
+    if isinstance(definition, str):
+        definition = load_task(definition)
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    world = World.from_scene(scene)
+    builder = _Builder(definition, world, rng)
+    builder.bind_room_objects()
+    builder.create_items()
+    t_bind = time.perf_counter() - t0
+    builder.place_items()
+    builder.place_robot()
+    world.assign_labels()
+    t_place = time.perf_counter() - t0 - t_bind
+    instance = TaskInstance(
+        task=definition.name, scene=scene.name, seed=seed, world=world, description="",
+        scope=builder.scope, virtual_scopes=sorted(builder.virtual), unsupported_literals=builder.unsupported,
+        timings={}, definition=definition,
+    )
+    _verify_init(instance)
+    instance.description = task_description(instance)
+    instance.timings.update(bind=t_bind, place=t_place, instantiate=time.perf_counter() - t0)
+    return instance
+
+
+def task_description(instance: TaskInstance) -> str:
+    """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal."""
+    text = instance.definition.paper_description
+    if text is not None:
+        return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: instance.label(m.group(1)), text)
+    return describe_goal(instance.definition.goal, instance.label)
+
+
+def literal_text(literal: ParsedLiteral) -> str:
+    """A parsed bddl literal in BDDL form: ['not', ['open', 'x']] -> '(not (open x))'."""
+    return "(" + " ".join(literal_text(x) if isinstance(x, list) else x for x in literal) + ")"
+
+
+class _Builder:
+    """Scratch state of one instantiation."""
+
+    def __init__(self, definition: TaskDefinition, world: World, rng: np.random.Generator) -> None:
+        self.d, self.world, self.rng = definition, world, rng
+        self.scope: dict[str, str] = {}
+        self.virtual: set[str] = set()
+        self.unsupported: list[str] = []
+        self.items: list[str] = []
+        self.agent_floor: str | None = None
+        future = {lit[1] for lit in definition.init if lit[0] == "future"}
+        tax = catalog.taxonomy()
+        for synset, scopes in definition.objects.items():
+            for s in scopes:
+                if synset == "agent.n.01":
+                    self.scope[s] = ROBOT_NAME
+                elif s in future or (tax.is_valid_synset(synset) and tax.has_ability(synset, "substance")):
+                    self.scope[s] = s
+                    self.virtual.add(s)
+
+    # -- step 1: scene objects --------------------------------------------------------------------
+    def bind_room_objects(self) -> None:
+        by_type: dict[str, list[str]] = {}
+        for lit in self.d.init:
+            if lit[0] == "inroom" and lit[1] not in self.scope:
+                by_type.setdefault(lit[2], []).append(lit[1])
+        for room_type, scopes in by_type.items():
+            rooms = [r for r in self.world.scene.rooms if r.type == room_type]
+            if not rooms:
+                raise InstantiationError(
+                    f"scene {self.world.scene.name} has no {room_type}", literal_text(["inroom", scopes[0], room_type])
+                )
+            best: dict[str, str] = {}
+            for room in rooms:
+                match = self._match_room(room.id, scopes)
+                if len(match) == len(scopes):
+                    best = match
+                    break
+                if len(match) >= len(best):
+                    best = match
+            missing = [s for s in scopes if s not in best]
+            if missing:
+                raise InstantiationError(
+                    f"no {room_type} of scene {self.world.scene.name} holds a {scope_synset(missing[0])} "
+                    f"for every inroom scope ({', '.join(missing)} unmatched)",
+                    literal_text(["inroom", missing[0], room_type]),
+                )
+            self.scope.update(best)
+
+    def _match_room(self, room_id: str, scopes: list[str]) -> dict[str, str]:
+        """Largest one-to-one assignment of scopes to this room's floor / furniture of matching category."""
+        graph = nx.Graph()
+        graph.add_nodes_from(("s", s) for s in scopes)
+        for s in scopes:
+            cats = set(catalog.synset_categories(scope_synset(s)))
+            for obj in self.world.objects.values():
+                if obj.room != room_id or obj.kind not in ("floor", "furniture"):
+                    continue
+                if (obj.kind == "floor" and scope_synset(s) == "floor.n.01") or (obj.kind == "furniture" and obj.category in cats):
+                    graph.add_edge(("s", s), ("o", obj.name))
+        matching = nx.bipartite.maximum_matching(graph, top_nodes=[("s", s) for s in scopes])
+        return {s: matching[("s", s)][1] for s in scopes if ("s", s) in matching}
+
+    # -- step 3: new items --------------------------------------------------------------------------
+    def create_items(self) -> None:
+        sized = set(catalog.sized_categories())
+        taken = set(self.world.objects) | {ROBOT_NAME}
+        for s in self.d.scopes:
+            if s in self.scope:
+                continue
+            synset = scope_synset(s)
+            cats = [c for c in catalog.synset_categories(synset) if c in sized]
+            if not cats:
+                raise InstantiationError(f"no object category with a known size for {synset} (scope {s})")
+            lemma = synset.split(".")[0]
+            category = lemma if lemma in cats else str(self.rng.choice(cats))
+            name = _item_name(s, taken)
+            taken.add(name)
+            self.world.add(WorldObject(
+                name=name, category=category, kind="item", synset=synset,
+                center=np.zeros(3), size=np.array(catalog.category_size(category), dtype=float),
+                openable=catalog.is_openable(category),
+            ))
+            self.scope[s] = name
+            self.items.append(s)
+
+    # -- step 4: placement ----------------------------------------------------------------------------
+    def place_items(self) -> None:
+        placement: dict[str, ParsedLiteral] = {}
+        states: list[ParsedLiteral] = []
+        for lit in self.d.init:
+            atom, negated = (lit[1], True) if lit[0] == "not" else (lit, False)
+            pred, args = atom[0], atom[1:]
+            if pred == "inroom" or (pred == "ontop" and args[0] in self.scope and self.scope[args[0]] == ROBOT_NAME):
+                if pred == "ontop":
+                    self.agent_floor = self.scope.get(args[1])
+                continue
+            if pred not in SUPPORTED_PREDICATES or any(a in self.virtual for a in args):
+                self.unsupported.append(literal_text(lit))
+            elif pred == "open":
+                states.append(lit)
+            elif pred in PLACEMENT_PREDICATES and not negated and args[0] in self.items:
+                current = placement.get(args[0])
+                if current is None or PLACEMENT_PREDICATES.index(pred) < PLACEMENT_PREDICATES.index(current[0]):
+                    placement[args[0]] = atom
+        order = nx.DiGraph()
+        order.add_nodes_from(self.items)
+        for s, atom in placement.items():
+            if atom[2] in self.items:
+                order.add_edge(atom[2], s)
+        try:
+            ordered = list(nx.lexicographical_topological_sort(order))
+        except nx.NetworkXUnfeasible:
+            raise InstantiationError(f"task {self.d.name}: init placements form a cycle") from None
+        opened = {lit[1] for lit in states if lit[0] == "open"}
+        for s in ordered:
+            atom = placement.get(s)
+            if atom is None:
+                self._on_free_floor(self.scope[s], self._default_floor())
+            else:
+                self._place(atom, opened)
+        for lit in states:
+            negated = lit[0] == "not"
+            target = self.world.objects[self.scope[(lit[1] if negated else lit)[1]]]
+            if not target.openable:
+                raise InstantiationError(f"{target.name} ({target.category}) cannot be opened or closed", literal_text(lit))
+            self.world.set_open(target.name, not negated)
+
+    def _place(self, atom: ParsedLiteral, opened: set[str]) -> None:
+        pred, a, b = atom[0], self.scope[atom[1]], self.scope[atom[2]]
+        support = self.world.objects[b]
+        if pred in ("ontop", "inside") and support.kind == "floor":
+            self._on_free_floor(a, b)
+        elif pred in ("ontop", "inside"):
+            self.world.place(a, b, pred)
+            if pred == "inside" and support.openable and atom[2] not in opened:
+                support.is_open = False
+        elif pred == "under":
+            floor = f"floor_{support.room}"
+            self.world.place_on_floor_at(a, floor, (float(support.center[0]), float(support.center[1])))
+        elif support.parent is None or self.world.objects[support.parent].kind == "floor" or support.kind != "item":
+            self._on_free_floor(a, f"floor_{support.room}", near=support)
+        else:
+            self.world.place(a, support.parent, support.relation or "ontop")
+
+    def _default_floor(self) -> str:
+        return self.agent_floor or f"floor_{self.world.scene.rooms[0].id}"
+
+    def _on_free_floor(self, name: str, floor: str, near: WorldObject | None = None) -> None:
+        obj, room = self.world.objects[name], self.world.objects[floor].room
+        xy = free_floor_spot(self.world, room, obj.size[:2] / 2 + FLOOR_MARGIN_M, self.rng, near=near, exclude=name)
+        if xy is None:
+            where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
+            raise InstantiationError(f"no free spot for {name} {where}")
+        self.world.place_on_floor_at(name, floor, xy)
+
+    # -- step 5: robot ------------------------------------------------------------------------------
+    def place_robot(self) -> None:
+        floor = self._default_floor()
+        room = self.world.objects[floor].room
+        xy = free_floor_spot(self.world, room, np.full(2, ROBOT_CLEARANCE_M), self.rng)
+        if xy is None:
+            raise InstantiationError(f"no free spot for the robot in {room}")
+        self.world.set_robot_pose(xy[0], xy[1], float(self.rng.uniform(-np.pi, np.pi)))
+
+
+def _item_name(scope: str, taken: set[str]) -> str:
+    """'apple.n.01_1' -> 'apple_1'; 'plate.n.04_1' -> 'plate_n04_1' when 'plate_1' is taken."""
+    synset, index = scope.rsplit("_", 1)
+    lemma, _, sense = synset.split(".")
+    for name in (f"{lemma}_{index}", f"{lemma}_n{sense}_{index}"):
+        if name not in taken:
+            return name
+    k = 2
+    while f"{lemma}_n{sense}_{index}_{k}" in taken:
+        k += 1
+    return f"{lemma}_n{sense}_{index}_{k}"
+
+
+def _readable(world: World, name: str) -> str:
+    if name == ROBOT_NAME:
+        return "the robot"
+    obj = world.objects.get(name)
+    if obj is None:
+        return name.rsplit("_", 1)[0].split(".")[0].replace("__", " ").replace("_", " ")
+    if obj.kind == "floor":
+        room = world.scene.room(obj.room) if obj.room else None
+        return f"the {room.type.replace('_', ' ')} floor" if room else "the floor"
+    return obj.label or obj.name
+
+
+def free_floor_spot(
+    world: World, room_id: str | None, half: np.ndarray, rng: np.random.Generator,
+    near: WorldObject | None = None, exclude: str | None = None,
+) -> tuple[float, float] | None:
+    """A random (x, y) in a room where a box of half extents ``half`` overlaps no furniture, wall,
+    door opening or floor item; with ``near``, within ``NEXTTO``-like reach of that object's box."""
+    room = world.scene.room(room_id) if room_id else world.scene.rooms[0]
+    x0, y0, x1, y1 = room.bounds
+    lo, hi = np.array([x0, y0]) + half, np.array([x1, y1]) - half
+    if np.any(lo >= hi):
+        return None
+    boxes = _floor_obstacles(world, exclude)
+    if near is not None:
+        nlo = np.maximum(lo, near.center[:2] - near.size[:2] / 2 - 2 * half - 0.1)
+        nhi = np.minimum(hi, near.center[:2] + near.size[:2] / 2 + 2 * half + 0.1)
+        if np.all(nlo < nhi):
+            lo, hi = nlo, nhi
+    for _ in range(SAMPLE_TRIES):
+        p = rng.uniform(lo, hi)
+        if not np.any(np.all((boxes[:, :2] < p + half) & (boxes[:, 2:] > p - half), axis=1)):
+            return float(p[0]), float(p[1])
+    return None
+
+
+def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
+    """(n, 4) array of footprints (xmin, ymin, xmax, ymax) a floor spot must avoid."""
+    rows = [w.bounds for w in world.scene.walls]
+    for obj in world.objects.values():
+        if obj.name == exclude or obj.kind == "floor":
+            continue
+        if obj.kind == "item" and not (obj.parent and world.objects[obj.parent].kind == "floor"):
+            continue
+        lo, hi = obj.box()
+        pad = DOOR_KEEPOUT_M if obj.kind == "door" else 0.0
+        rows.append((lo[0] - pad, lo[1] - pad, hi[0] + pad, hi[1] + pad))
+    return np.asarray(rows, dtype=float).reshape(-1, 4)
+
+
+def _verify_init(instance: TaskInstance) -> None:
+    """Evaluate every applied init literal through the backend; raise on the first false one."""
+    unsupported = set(instance.unsupported_literals)
+    backend = WorldBackend(instance.world)
+    scope = instance.scope_objects()
+    for lit in instance.definition.init:
+        text = literal_text(lit)
+        if lit[0] == "inroom" or text in unsupported:
+            continue
+        head = compile_state([lit], backend, scope=dict(scope), object_map=instance.definition.objects,
+                             generate_ground_options=False)[0]
+        if not head.evaluate():
+            raise InstantiationError(f"init literal {text} does not hold after placement in {instance.scene}", text)

@@ -1,0 +1,102 @@
+"""Low-level base motion: move forward 7.5 cm, turn in place by up to 35 degrees (paper S.3).
+
+The base is a disc checked against the world's geometry in 2D: wall pieces, closed door leaves and
+furniture whose boxes start below ``NavConfig.obstacle_max_bottom_m`` (so the wall above a window or
+door, and wall cabinets, do not block). Items never block: like the paper, which takes
+non-physical steps because its robot could not fit through narrow spots (S.2), we let the base pass
+over small objects, and we check collisions with a disc of ``NavConfig.robot_radius_m`` = 0.2 m,
+smaller than Fetch's ~0.28 m base, the same radius the ground-truth navigation grid keeps. A move
+that would push the disc further into an obstacle leaves the pose unchanged and says so; one that
+reduces an existing overlap is allowed, so a robot put in a tight spot can always back out of it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+
+from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
+from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
+from more_agent.sim.world import World
+
+
+class MotionFailure(str, Enum):
+    """Why a low-level move failed."""
+
+    BLOCKED = "blocked"
+    INVALID_AMOUNT = "invalid_amount"
+
+
+@dataclass(frozen=True)
+class MotionResult:
+    """Outcome of one low-level move: success, reason and feedback, and the amount actually applied."""
+
+    ok: bool
+    reason: MotionFailure | None
+    feedback: str
+    applied: float
+    """Metres moved or radians turned (0 when the move failed); differs from the request when clipped."""
+    low_level_steps: int = 1
+
+
+def obstacle_boxes(world: World, config: NavConfig = DEFAULT_NAV) -> np.ndarray:
+    """(N, 4) footprints (xmin, ymin, xmax, ymax) of everything the base collides with now."""
+    rows = [w.bounds for w in world.scene.walls if w.z_min < config.obstacle_max_bottom_m]
+    for obj in world.objects.values():
+        blocks = (obj.kind == "door" and not obj.is_open) or (
+            obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m
+        )
+        if blocks:
+            lo, hi = obj.box()
+            rows.append((lo[0], lo[1], hi[0], hi[1]))
+    return np.asarray(rows, dtype=np.float64).reshape(-1, 4)
+
+
+def clearance(boxes: np.ndarray, x: float, y: float) -> float:
+    """Signed distance from (x, y) to the nearest box footprint: negative inside one, inf with no boxes."""
+    if len(boxes) == 0:
+        return math.inf
+    dx = np.maximum(boxes[:, 0] - x, x - boxes[:, 2])
+    dy = np.maximum(boxes[:, 1] - y, y - boxes[:, 3])
+    outside = np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+    inside = np.minimum(np.maximum(dx, dy), 0.0)
+    return float(np.min(outside + inside))
+
+
+def move_forward(world: World, distance: float = FORWARD_STEP_M, config: NavConfig = DEFAULT_NAV) -> MotionResult:
+    """Drive straight ahead by ``distance`` metres (at most 7.5 cm; more is clipped and reported)."""
+    if not math.isfinite(distance) or distance < 0:
+        return MotionResult(False, MotionFailure.INVALID_AMOUNT, f"cannot move forward by {distance} m", 0.0)
+    step = min(distance, FORWARD_STEP_M)
+    note = f" (clipped from {distance:.3f} m)" if step < distance else ""
+    r = world.robot
+    x, y = r.x + step * math.cos(r.yaw), r.y + step * math.sin(r.yaw)
+    x0, y0, x1, y1 = world.scene.bounds
+    boxes = obstacle_boxes(world, config)
+    before = clearance(boxes, r.x, r.y) - config.robot_radius_m
+    after = clearance(boxes, x, y) - config.robot_radius_m
+    if not (x0 <= x <= x1 and y0 <= y <= y1) or (after < 0 and after < before):
+        return MotionResult(False, MotionFailure.BLOCKED, "blocked: something is in the way", 0.0)
+    world.set_robot_pose(x, y, r.yaw)
+    return MotionResult(True, None, f"moved forward {step:.3f} m{note}", step)
+
+
+def turn(world: World, angle: float) -> MotionResult:
+    """Turn in place by ``angle`` radians, positive to the left (counter-clockwise); |angle| is clipped to 35 degrees."""
+    if not math.isfinite(angle):
+        return MotionResult(False, MotionFailure.INVALID_AMOUNT, f"cannot turn by {angle} rad", 0.0)
+    applied = max(-MAX_TURN_RAD, min(MAX_TURN_RAD, angle))
+    note = f" (clipped from {math.degrees(angle):.1f} deg)" if applied != angle else ""
+    r = world.robot
+    world.set_robot_pose(r.x, r.y, r.yaw + applied)
+    side = "left" if applied >= 0 else "right"
+    return MotionResult(True, None, f"turned {side} {abs(math.degrees(applied)):.1f} deg{note}", applied)
+
+
+def full_turn_angles(max_turn: float = MAX_TURN_RAD) -> list[float]:
+    """Equal left turns of at most ``max_turn`` that add up to one full turn (11 of 32.7 deg for 35 deg)."""
+    n = math.ceil(2 * math.pi / max_turn - 1e-9)
+    return [2 * math.pi / n] * n

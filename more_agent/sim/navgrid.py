@@ -1,0 +1,244 @@
+"""Ground-truth navigation: a free-space raster of the world and shortest paths on it.
+
+The raster covers the scene at ``NavConfig.resolution_m`` (0.075 m, the paper's map resolution).
+A cell is free when it lies in a room (or a door's passage) and is at least ``robot_radius_m`` from
+every wall, closed door and piece of furniture. Items are not obstacles: the paper takes
+non-physical steps where collisions would be unavoidable (S.2). The radius (0.2 m by default,
+smaller than Fetch's ~0.28 m base) is chosen so that 0.9 m doors and 0.8 m corridors stay passable.
+
+Grids depend only on the scene and on which doors are closed, so they are cached per (scene, closed
+doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
+simplified to polylines. ``blocking_door`` names the closed door on the way when a goal is only
+reachable with doors open: the magic actions report it so that a planner knows what to open.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy import ndimage
+from skimage.graph import MCP_Geometric
+from skimage.measure import approximate_polygon
+
+from more_agent.sim.scene import Bounds2D, Door
+from more_agent.sim.world import World
+
+XY = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class NavConfig:
+    """Knobs of the ground-truth navigation grid."""
+
+    resolution_m: float = 0.075
+    """Cell size in metres (the paper's map resolution)."""
+
+    robot_radius_m: float = 0.2
+    """Clearance kept from walls, closed doors and furniture; small enough for 0.9 m doors and 0.8 m corridors."""
+
+    door_passage_m: float = 0.3
+    """How far a door's passage strip reaches into the rooms on either side (bridges wall thickness)."""
+
+    obstacle_max_bottom_m: float = 1.2
+    """Furniture whose box starts above this height (wall cabinets) does not block the base."""
+
+
+DEFAULT_NAV = NavConfig()
+
+_CACHE_SIZE = 16
+
+
+@dataclass(frozen=True, eq=False)
+class NavGrid:
+    """Boolean free-space raster: ``free[row, col]`` with row along +y and col along +x."""
+
+    free: np.ndarray
+    origin: XY
+    resolution_m: float
+    closed_doors: frozenset[str]
+    door_cells: dict[str, np.ndarray] = field(repr=False)
+    """Per door id, a boolean mask of its passage strip (used to name a blocking door)."""
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.free.shape  # type: ignore[return-value]
+
+    def to_cell(self, x: float, y: float) -> tuple[int, int]:
+        """The (row, col) of the cell containing (x, y), clipped to the grid."""
+        r = int(np.floor((y - self.origin[1]) / self.resolution_m))
+        c = int(np.floor((x - self.origin[0]) / self.resolution_m))
+        return min(max(r, 0), self.shape[0] - 1), min(max(c, 0), self.shape[1] - 1)
+
+    def to_xy(self, r: int, c: int) -> XY:
+        """World coordinates of a cell's centre."""
+        return (self.origin[0] + (c + 0.5) * self.resolution_m, self.origin[1] + (r + 0.5) * self.resolution_m)
+
+    def is_free(self, x: float, y: float) -> bool:
+        """Whether the robot base may stand at (x, y)."""
+        r, c = self.to_cell(x, y)
+        inside = self.origin[0] <= x < self.origin[0] + self.shape[1] * self.resolution_m and (
+            self.origin[1] <= y < self.origin[1] + self.shape[0] * self.resolution_m
+        )
+        return inside and bool(self.free[r, c])
+
+    @cached_property
+    def _nearest_free(self) -> tuple[np.ndarray, np.ndarray]:
+        _, (rows, cols) = ndimage.distance_transform_edt(~self.free, return_indices=True)
+        return rows, cols
+
+    def snap(self, x: float, y: float) -> tuple[int, int] | None:
+        """The free cell nearest to (x, y), or None when the grid has no free cell."""
+        if not self.free.any():
+            return None
+        r, c = self.to_cell(x, y)
+        rows, cols = self._nearest_free
+        return int(rows[r, c]), int(cols[r, c])
+
+
+def _mask_box(shape: tuple[int, int], origin: XY, res: float, box: Bounds2D) -> tuple[slice, slice]:
+    """Row/col slices of the cells whose centres lie inside ``box``."""
+    x0, y0, x1, y1 = box
+    c0 = int(np.ceil((x0 - origin[0]) / res - 0.5))
+    c1 = int(np.floor((x1 - origin[0]) / res - 0.5)) + 1
+    r0 = int(np.ceil((y0 - origin[1]) / res - 0.5))
+    r1 = int(np.floor((y1 - origin[1]) / res - 0.5)) + 1
+    return slice(max(r0, 0), max(min(r1, shape[0]), 0)), slice(max(c0, 0), max(min(c1, shape[1]), 0))
+
+
+def _door_strip(door: Door, reach: float) -> Bounds2D:
+    """A door's opening extended along the wall normal by ``reach`` on either side."""
+    x0, y0, x1, y1 = door.bounds()
+    return (x0, y0 - reach, x1, y1 + reach) if door.axis == "x" else (x0 - reach, y0, x1 + reach, y1)
+
+
+def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
+    scene, res = world.scene, config.resolution_m
+    bx0, by0, bx1, by1 = scene.bounds
+    origin = (bx0 - res, by0 - res)
+    shape = (int(np.ceil((by1 - by0) / res)) + 2, int(np.ceil((bx1 - bx0) / res)) + 2)
+
+    region = np.zeros(shape, dtype=bool)
+    for room in scene.rooms:
+        region[_mask_box(shape, origin, res, room.bounds)] = True
+    blocked = np.zeros(shape, dtype=bool)
+    for wall in scene.walls:
+        blocked[_mask_box(shape, origin, res, wall.bounds)] = True
+    door_cells: dict[str, np.ndarray] = {}
+    for door in scene.doors:
+        passage = np.zeros(shape, dtype=bool)
+        passage[_mask_box(shape, origin, res, _door_strip(door, config.door_passage_m))] = True
+        door_cells[door.id] = passage
+        region |= passage
+        # The opening is a gap in its wall whatever the wall list says; a closed leaf fills it.
+        opening = _mask_box(shape, origin, res, _door_strip(door, door.thickness / 2 + res))
+        blocked[opening] = door.id in closed
+    for obj in world.objects.values():
+        if obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m:
+            lo, hi = obj.box()
+            blocked[_mask_box(shape, origin, res, (lo[0], lo[1], hi[0], hi[1]))] = True
+
+    passable = region & ~blocked
+    clearance = ndimage.distance_transform_edt(passable) * res
+    return NavGrid(
+        free=clearance > config.robot_radius_m, origin=origin, resolution_m=res, closed_doors=closed,
+        door_cells=door_cells,
+    )
+
+
+_cache: OrderedDict[tuple[int, frozenset[str], NavConfig], tuple[World, NavGrid]] = OrderedDict()
+
+
+def closed_doors(world: World) -> frozenset[str]:
+    """Names of the world's doors that are closed now."""
+    return frozenset(o.name for o in world.objects.values() if o.kind == "door" and not o.is_open)
+
+
+def nav_grid(world: World, config: NavConfig = DEFAULT_NAV, *, all_doors_open: bool = False) -> NavGrid:
+    """The free-space raster for the world's current door states (or with every door open); cached.
+
+    Furniture never moves, so a grid only depends on the world's scene and its closed doors.
+    """
+    closed = frozenset() if all_doors_open else closed_doors(world)
+    key = (id(world.scene), closed, config)
+    hit = _cache.get(key)
+    if hit is not None and hit[0].scene is world.scene:
+        _cache.move_to_end(key)
+        return hit[1]
+    grid = _build(world, closed, config)
+    _cache[key] = (world, grid)
+    while len(_cache) > _CACHE_SIZE:
+        _cache.popitem(last=False)
+    return grid
+
+
+@dataclass(frozen=True)
+class PathResult:
+    """The shortest path from a start to the nearest of several goals (or none)."""
+
+    goal_index: int | None
+    """Index into the goals given of the one reached, None when none is reachable."""
+
+    length_m: float
+    """Path length in metres (inf when unreachable)."""
+
+    waypoints: list[XY]
+    """Simplified polyline from the start to the goal, both included; empty when unreachable."""
+
+    cells: list[tuple[int, int]] = field(repr=False, default_factory=list)
+    """The raw 8-connected cell path."""
+
+    @property
+    def found(self) -> bool:
+        return self.goal_index is not None
+
+
+_NO_PATH = PathResult(goal_index=None, length_m=float("inf"), waypoints=[])
+
+
+def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
+    """Shortest 8-connected path over free cells from ``start`` to the nearest of ``goals``.
+
+    The start snaps to its nearest free cell (the robot may stand in a spot the inflated grid
+    forbids after a non-physical step); goals must be free themselves or are ignored.
+    """
+    start_cell = grid.snap(*start)
+    goal_cells = [grid.to_cell(*g) for g in goals if grid.is_free(*g)]
+    goal_index = [i for i, g in enumerate(goals) if grid.is_free(*g)]
+    if start_cell is None or not goal_cells:
+        return _NO_PATH
+    costs = np.where(grid.free, 1.0, np.inf)
+    mcp = MCP_Geometric(costs)
+    cum, _ = mcp.find_costs([start_cell], goal_cells, find_all_ends=False)
+    reached = [(float(cum[cell]), i) for i, cell in enumerate(goal_cells) if np.isfinite(cum[cell])]
+    if not reached:
+        return _NO_PATH
+    cost, k = min(reached)
+    cells = [tuple(map(int, rc)) for rc in mcp.traceback(goal_cells[k])]
+    simplified = approximate_polygon(np.asarray(cells, dtype=float), tolerance=1.0)
+    waypoints = [(float(start[0]), float(start[1]))]
+    waypoints += [grid.to_xy(int(round(r)), int(round(c))) for r, c in simplified[1:-1]]
+    waypoints.append((float(goals[goal_index[k]][0]), float(goals[goal_index[k]][1])))
+    return PathResult(goal_index=goal_index[k], length_m=cost * grid.resolution_m, waypoints=waypoints, cells=cells)
+
+
+def blocking_door(world: World, start: XY, goals: Sequence[XY], config: NavConfig = DEFAULT_NAV) -> str | None:
+    """The first closed door along the way to the nearest goal, when only open doors would make it reachable."""
+    closed = closed_doors(world)
+    if not closed:
+        return None
+    open_grid = nav_grid(world, config, all_doors_open=True)
+    path = shortest_path(open_grid, start, goals)
+    for r, c in path.cells:
+        for door_id in sorted(closed):
+            if open_grid.door_cells[door_id][r, c]:
+                return door_id
+    return None
+
+
+def reachable(world: World, start: XY, goal: XY, config: NavConfig = DEFAULT_NAV) -> bool:
+    """Whether the robot can drive from ``start`` to ``goal`` with the doors as they are."""
+    return shortest_path(nav_grid(world, config), start, [goal]).found

@@ -1,0 +1,347 @@
+"""Headless ray caster: depth, semantic, instance and flat-shaded RGB frames from a World.
+
+Everything in the world is an axis-aligned box, so a frame is cast on the CPU (numpy + numba, no
+OpenGL / X / EGL / GPU): boxes are bucketed in a uniform 2D grid of ~1 m cells, and each pixel's ray
+walks that grid (2D DDA), slab-testing the boxes of each cell and stopping at the first cell that
+holds the nearest hit. One core (no parallel loops).
+
+What is drawn (docs/sensors.md):
+- room ground as its thin floor slab (semantic = the room's ground class, instance 0);
+- walls with their z ranges (class "wall", instance 0); windows are the gaps between wall pieces,
+  see-through and unlabelled;
+- per door a lintel above the opening (class "door", the door's instance id), plus the leaf filling
+  the opening while the door is closed; open leaves are not drawn;
+- furniture and items as boxes with their category and instance id; items only while
+  ``world.is_observable`` (not held, not inside a closed container). An open container, or a
+  non-openable one with something inside, is a cage: bottom and top slabs of
+  ``SLAB_FRACTION * height`` and four thin corner posts, so its contents show while its observed
+  extent stays its full box. A closed container is solid, which hides its contents.
+No ceiling; no robot body.
+"""
+
+from __future__ import annotations
+
+import zlib
+from colorsys import hsv_to_rgb
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from more_agent.sim.camera import Camera
+from more_agent.sim.world import SLAB_FRACTION, World, WorldObject
+
+GRID_CELL_M = 1.0
+"""Side of the acceleration grid's cells in metres."""
+
+CAGE_POST_M = 0.03
+"""Side of the corner posts of an open container's cage (at most 15% of its footprint)."""
+
+DOOR_INSET_M = 0.002
+"""How far door boxes stand proud of their wall on each side (so the door wins ties with the wall)."""
+
+PATCH_TOP_M = 0.001
+"""Top of a ground patch (carpet, driveway) slab: just above the room floor so that it shows."""
+
+_STRUCTURAL_COLORS: dict[str, tuple[int, int, int]] = {
+    "unlabeled": (0, 0, 0), "floor": (196, 170, 130), "carpet": (150, 70, 80), "lawn": (90, 160, 70),
+    "driveway": (120, 120, 120), "wall": (225, 225, 215), "door": (140, 90, 50), "window": (150, 200, 230),
+}
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One camera frame. depth: (H, W) float32 z-depth in metres, NaN where invalid (nothing hit or
+    beyond range); semantic / instance: (H, W) int32 (0 = unlabelled / none); rgb: (H, W, 3) uint8;
+    K: (3, 3) intrinsics; T_world_cam: (4, 4) camera-to-world pose (OpenCV camera axes)."""
+
+    rgb: np.ndarray
+    depth: np.ndarray
+    semantic: np.ndarray
+    instance: np.ndarray
+    K: np.ndarray
+    T_world_cam: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class SceneGeometry:
+    """The boxes a world draws (float64 corners, int32 class / instance ids) bucketed in a 2D grid.
+
+    ``cell_start[c]:cell_start[c + 1]`` indexes ``cell_items``, the boxes overlapping cell c, with
+    c = iy * nx + ix.
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    semantic: np.ndarray
+    instance: np.ndarray
+    origin: tuple[float, float]
+    cell: float
+    shape: tuple[int, int]
+    cell_start: np.ndarray
+    cell_items: np.ndarray
+
+    @property
+    def n_boxes(self) -> int:
+        return len(self.semantic)
+
+
+def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometry:
+    """Every box the world draws in its current state, with the grid that accelerates ray casting."""
+    boxes: list[tuple[np.ndarray, np.ndarray, int, int]] = []
+    for door in (o for o in world.objects.values() if o.kind == "door"):
+        boxes.extend(_door_boxes(world, door))
+    wall = world.semantic_id("wall")
+    for w in world.scene.walls:
+        x0, y0, x1, y1 = w.bounds
+        boxes.append((np.array([x0, y0, w.z_min]), np.array([x1, y1, w.z_max]), wall, 0))
+    for patch in world.scene.ground_patches:
+        x0, y0, x1, y1 = patch.bounds
+        boxes.append((np.array([x0, y0, -0.01]), np.array([x1, y1, PATCH_TOP_M]), world.semantic_id(patch.ground), 0))
+    holds_inside = {o.parent for o in world.objects.values() if o.relation == "inside"}
+    for obj in world.objects.values():
+        sem = world.semantic_id(obj.category)
+        lo, hi = obj.box()
+        if obj.kind == "floor":
+            boxes.append((lo, hi, sem, 0))
+        elif obj.kind == "furniture" or (obj.kind == "item" and world.is_observable(obj.name)):
+            see_through = obj.is_open if obj.openable else obj.name in holds_inside
+            parts = _cage(lo, hi) if see_through else [(lo, hi)]
+            boxes.extend((a, b, sem, obj.instance_id) for a, b in parts)
+    lo = np.array([b[0] for b in boxes], dtype=np.float64).reshape(-1, 3)
+    hi = np.array([b[1] for b in boxes], dtype=np.float64).reshape(-1, 3)
+    x0, y0, x1, y1 = world.scene.bounds
+    x0, y0 = min(x0, lo[:, 0].min()) - cell_m, min(y0, lo[:, 1].min()) - cell_m
+    nx = int(np.ceil((max(x1, hi[:, 0].max()) + cell_m - x0) / cell_m))
+    ny = int(np.ceil((max(y1, hi[:, 1].max()) + cell_m - y0) / cell_m))
+    start, items = _build_grid(lo, hi, x0, y0, cell_m, nx, ny)
+    return SceneGeometry(
+        lo=lo, hi=hi, semantic=np.array([b[2] for b in boxes], dtype=np.int32),
+        instance=np.array([b[3] for b in boxes], dtype=np.int32),
+        origin=(x0, y0), cell=cell_m, shape=(nx, ny), cell_start=start, cell_items=items,
+    )
+
+
+def _door_boxes(world: World, door: WorldObject) -> list[tuple[np.ndarray, np.ndarray, int, int]]:
+    """The lintel above a door's opening, and its leaf while closed.
+
+    Both are thickened by ``DOOR_INSET_M`` across the wall so that they, not the wall piece that
+    may share the lintel's box, are what the camera sees (doors are listed first, too).
+    """
+    lo, hi = door.box()
+    across = 1 if door.size[1] < door.size[0] else 0
+    lo[across] -= DOOR_INSET_M
+    hi[across] += DOOR_INSET_M
+    sem, top = world.semantic_id(door.category), world.scene.wall_height
+    out = []
+    if top > hi[2]:
+        out.append((np.array([lo[0], lo[1], hi[2]]), np.array([hi[0], hi[1], top]), sem, door.instance_id))
+    if not door.is_open:
+        out.append((lo, hi, sem, door.instance_id))
+    return out
+
+
+def _cage(lo: np.ndarray, hi: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Bottom slab, top slab and four corner posts of an open container's box."""
+    slab = SLAB_FRACTION * (hi[2] - lo[2])
+    post = np.minimum(CAGE_POST_M, 0.15 * (hi[:2] - lo[:2]))
+    parts = [(lo, np.array([hi[0], hi[1], lo[2] + slab])), (np.array([lo[0], lo[1], hi[2] - slab]), hi)]
+    for px in (lo[0], hi[0] - post[0]):
+        for py in (lo[1], hi[1] - post[1]):
+            parts.append((np.array([px, py, lo[2] + slab]), np.array([px + post[0], py + post[1], hi[2] - slab])))
+    return parts
+
+
+@njit(cache=True)
+def _build_grid(lo: np.ndarray, hi: np.ndarray, x0: float, y0: float, cell: float, nx: int, ny: int) -> tuple[np.ndarray, np.ndarray]:
+    """CSR lists of the boxes overlapping each grid cell (counting pass, then filling pass)."""
+    n = lo.shape[0]
+    ranges = np.empty((n, 4), dtype=np.int64)
+    count = np.zeros(nx * ny + 1, dtype=np.int32)
+    for b in range(n):
+        ix0 = max(0, min(nx - 1, int(np.floor((lo[b, 0] - x0) / cell))))
+        ix1 = max(0, min(nx - 1, int(np.floor((hi[b, 0] - x0) / cell))))
+        iy0 = max(0, min(ny - 1, int(np.floor((lo[b, 1] - y0) / cell))))
+        iy1 = max(0, min(ny - 1, int(np.floor((hi[b, 1] - y0) / cell))))
+        ranges[b, 0], ranges[b, 1], ranges[b, 2], ranges[b, 3] = ix0, ix1, iy0, iy1
+        for iy in range(iy0, iy1 + 1):
+            for ix in range(ix0, ix1 + 1):
+                count[iy * nx + ix + 1] += 1
+    start = np.cumsum(count).astype(np.int32)
+    fill = start[:-1].copy()
+    items = np.empty(start[-1], dtype=np.int32)
+    for b in range(n):
+        for iy in range(ranges[b, 2], ranges[b, 3] + 1):
+            for ix in range(ranges[b, 0], ranges[b, 1] + 1):
+                c = iy * nx + ix
+                items[fill[c]] = b
+                fill[c] += 1
+    return start, items
+
+
+@njit(cache=True, error_model="numpy")
+def _cast(origin: np.ndarray, rot: np.ndarray, rays: np.ndarray, max_t: float, x0: float, y0: float, cell: float,
+          nx: int, ny: int, start: np.ndarray, items: np.ndarray, lo: np.ndarray, hi: np.ndarray, box_sem: np.ndarray,
+          box_inst: np.ndarray, palette: np.ndarray, depth: np.ndarray, sem: np.ndarray, inst: np.ndarray,
+          rgb: np.ndarray) -> None:
+    """Nearest hit of each ray origin + t * rot @ rays[r], t in [0, max_t]; NaN / 0 / 0 / black on a miss.
+
+    Camera-frame rays have z = 1, so t is the z-depth. Each box is tested once per ray (mailbox).
+    The colour is the class's palette entry dimmed by the face hit and by depth.
+    """
+    n_boxes = lo.shape[0]
+    mailbox = np.full(n_boxes, -1, dtype=np.int64)
+    zlo, zhi = np.inf, -np.inf
+    for b in range(n_boxes):
+        zlo, zhi = min(zlo, lo[b, 2]), max(zhi, hi[b, 2])
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    gx1, gy1 = x0 + nx * cell, y0 + ny * cell
+    for r in range(rays.shape[0]):
+        depth[r], sem[r], inst[r] = np.nan, 0, 0
+        rgb[r, 0], rgb[r, 1], rgb[r, 2] = 0, 0, 0
+        dx = rot[0, 0] * rays[r, 0] + rot[0, 1] * rays[r, 1] + rot[0, 2]
+        dy = rot[1, 0] * rays[r, 0] + rot[1, 1] * rays[r, 1] + rot[1, 2]
+        dz = rot[2, 0] * rays[r, 0] + rot[2, 1] * rays[r, 1] + rot[2, 2]
+        if dx == 0.0:
+            dx = 1e-12
+        if dy == 0.0:
+            dy = 1e-12
+        if dz == 0.0:
+            dz = 1e-12
+        ix_, iy_, iz_ = 1.0 / dx, 1.0 / dy, 1.0 / dz
+        # clip the ray to the grid's xy extent, the boxes' z extent and the range
+        ta, tb = (x0 - ox) * ix_, (gx1 - ox) * ix_
+        tn, tf = max(0.0, min(ta, tb)), min(max_t, max(ta, tb))
+        ta, tb = (y0 - oy) * iy_, (gy1 - oy) * iy_
+        tn, tf = max(tn, min(ta, tb)), min(tf, max(ta, tb))
+        ta, tb = (zlo - oz) * iz_, (zhi - oz) * iz_
+        tn, tf = max(tn, min(ta, tb)), min(tf, max(ta, tb))
+        if tn > tf:
+            continue
+        cx = min(nx - 1, max(0, int((ox + tn * dx - x0) / cell)))
+        cy = min(ny - 1, max(0, int((oy + tn * dy - y0) / cell)))
+        sx = 1 if dx > 0 else -1
+        sy = 1 if dy > 0 else -1
+        tmx = (x0 + (cx + (1 if sx > 0 else 0)) * cell - ox) * ix_
+        tmy = (y0 + (cy + (1 if sy > 0 else 0)) * cell - oy) * iy_
+        tdx, tdy = cell * abs(ix_), cell * abs(iy_)
+        best, best_b, best_f = np.inf, -1, -1
+        while True:
+            c = cy * nx + cx
+            for k in range(start[c], start[c + 1]):
+                b = items[k]
+                if mailbox[b] == r:
+                    continue
+                mailbox[b] = r
+                ta, tb = (lo[b, 0] - ox) * ix_, (hi[b, 0] - ox) * ix_
+                t0, t1, f = min(ta, tb), max(ta, tb), 0
+                ta, tb = (lo[b, 1] - oy) * iy_, (hi[b, 1] - oy) * iy_
+                if min(ta, tb) > t0:
+                    t0, f = min(ta, tb), 1
+                t1 = min(t1, max(ta, tb))
+                ta, tb = (lo[b, 2] - oz) * iz_, (hi[b, 2] - oz) * iz_
+                if min(ta, tb) > t0:
+                    t0, f = min(ta, tb), 2
+                t1 = min(t1, max(ta, tb))
+                if t0 <= t1 and t0 >= 0.0 and t0 < best:
+                    best, best_b, best_f = t0, b, f
+            t_exit = min(tmx, tmy)
+            if best <= t_exit or t_exit >= tf:
+                break
+            if tmx < tmy:
+                cx += sx
+                tmx += tdx
+                if cx < 0 or cx >= nx:
+                    break
+            else:
+                cy += sy
+                tmy += tdy
+                if cy < 0 or cy >= ny:
+                    break
+        if best_b >= 0 and best <= max_t:
+            depth[r], sem[r], inst[r] = best, box_sem[best_b], box_inst[best_b]
+            shade = (0.80 if best_f == 0 else 0.65 if best_f == 1 else 1.0) * (1.0 - 0.35 * best / max_t)
+            for ch in range(3):
+                rgb[r, ch] = np.uint8(palette[sem[r], ch] * shade + 0.5)
+
+
+def class_colors(class_names: list[str]) -> np.ndarray:
+    """(n, 3) uint8 colour per semantic class: fixed for structural classes, else from a hash of the name.
+
+    Hashing the name (not the id) keeps a category's colour the same across worlds and runs.
+    """
+    colors = np.empty((len(class_names), 3), dtype=np.uint8)
+    for i, name in enumerate(class_names):
+        if name in _STRUCTURAL_COLORS:
+            colors[i] = _STRUCTURAL_COLORS[name]
+        else:
+            h = zlib.crc32(name.encode())
+            rgb = hsv_to_rgb((h % 360) / 360, 0.45 + 0.4 * ((h >> 9) % 100) / 100, 0.55 + 0.4 * ((h >> 17) % 100) / 100)
+            colors[i] = np.round(np.array(rgb) * 255).astype(np.uint8)
+    return colors
+
+
+class Renderer:
+    """Renders frames of a world through one camera; rebuilds the box grid only when ``world.version`` changes."""
+
+    def __init__(self, camera: Camera | None = None) -> None:
+        self.camera = camera or Camera()
+        self._rays = self.camera.pixel_rays()
+        self._K = self.camera.intrinsics()
+        self._world: World | None = None
+        self._version = -1
+        self._geometry: SceneGeometry | None = None
+
+    def geometry(self, world: World) -> SceneGeometry:
+        """The world's current drawable boxes and grid (cached per world object and version)."""
+        if self._geometry is None or self._world is not world or self._version != world.version:
+            self._geometry = scene_geometry(world)
+            self._world, self._version = world, world.version
+        return self._geometry
+
+    def render(self, world: World) -> Frame:
+        """A frame from the robot's current pose."""
+        r = world.robot
+        return self.render_at(world, self.camera.pose(r.x, r.y, r.yaw))
+
+    def render_at(self, world: World, T_world_cam: np.ndarray) -> Frame:
+        """A frame from an arbitrary camera pose (4x4, camera to world)."""
+        g = self.geometry(world)
+        cam = self.camera
+        n = cam.width * cam.height
+        T = np.asarray(T_world_cam, dtype=np.float64)
+        depth = np.empty(n, dtype=np.float32)
+        sem = np.empty(n, dtype=np.int32)
+        inst = np.empty(n, dtype=np.int32)
+        rgb = np.empty((n, 3), dtype=np.uint8)
+        _cast(np.ascontiguousarray(T[:3, 3]), np.ascontiguousarray(T[:3, :3]), self._rays, cam.max_range_m,
+              g.origin[0], g.origin[1], g.cell, g.shape[0], g.shape[1], g.cell_start, g.cell_items, g.lo, g.hi,
+              g.semantic, g.instance, class_colors(world.class_names).astype(np.float64), depth, sem, inst, rgb)
+        hw = (cam.height, cam.width)
+        return Frame(rgb=rgb.reshape(*hw, 3), depth=depth.reshape(hw), semantic=sem.reshape(hw), instance=inst.reshape(hw),
+                     K=self._K.copy(), T_world_cam=T.copy())
+
+
+def render(world: World, camera: Camera | None = None) -> Frame:
+    """One frame from the robot's pose (builds the geometry afresh; keep a ``Renderer`` to reuse it)."""
+    return Renderer(camera).render(world)
+
+
+def instance_table(world: World, instance: np.ndarray) -> dict[int, dict[str, Any]]:
+    """Metadata of every instance id seen in an instance image, plus the held item.
+
+    Maps id -> {"name", "label", "category", "open" (bool, None when not openable), "held"}; the
+    held item is listed (held=True) although no camera sees it, so that a map can drop it from its
+    old place. Perception is ground truth in the paper (S.2), so this is read from the world.
+    """
+    seen = set(np.flatnonzero(np.bincount(instance.ravel())).tolist()) - {0}
+    by_id: dict[int, WorldObject] = {o.instance_id: o for o in world.objects.values()}
+    held = world.robot.held
+    if held is not None:
+        seen.add(world.objects[held].instance_id)
+    return {
+        i: {"name": by_id[i].name, "label": by_id[i].label, "category": by_id[i].category,
+            "open": bool(by_id[i].is_open) if by_id[i].openable else None, "held": by_id[i].name == held}
+        for i in sorted(seen)
+    }

@@ -1,0 +1,1 @@
+"""Pictures of maps, scene graphs and trajectories, and the HTML evaluation report."""

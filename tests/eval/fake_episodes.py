@@ -1,0 +1,85 @@
+"""Small deterministic episode functions for harness tests (importable by spawned workers)."""
+
+from __future__ import annotations
+
+import os
+import time
+import zlib
+from pathlib import Path
+
+from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, GoalCondition, LLMUsage
+
+
+def deterministic_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """An outcome that depends only on (task, seed, planner): 3 goal conditions, some met, some seen."""
+    h = zlib.crc32(f"{spec.task}|{spec.seed}|{spec.planner}".encode())
+    met = [bool(h >> k & 1) for k in range(3)]
+    seen = [f"obj_{k}" for k in range(3) if h >> (k + 3) & 1]
+    conds = [
+        GoalCondition(text=f"(ontop obj_{k} table_1)", satisfied=met[k], objects=[f"obj_{k}", "table_1"])
+        for k in range(3)
+    ]
+    all_met = all(met)
+    done = bool(h >> 6 & 1)
+    return EpisodeRecord(
+        task=spec.task,
+        scene=spec.scene or "Rs_int",
+        seed=spec.seed,
+        planner=spec.planner,
+        llm=spec.llm,
+        description=f"do {spec.task}",
+        success=all_met and done,
+        all_goals_met=all_met,
+        done_called=done,
+        task_progress=sum(met) / 3,
+        goal_conditions=conds,
+        observed_objects=[*seen, "table_1"],
+        high_level_steps=2,
+        actions=[
+            ActionRecord(step=0, name="navigate", arguments=["table_1"], ok=True),
+            ActionRecord(step=1, name="grasp", arguments=["obj_0"], ok=met[0], feedback="" if met[0] else "hand full"),
+        ],
+        trajectory=[(0.0, 0.0), (1.0, 0.5 * (h % 5)), (2.0, 1.0)],
+        llm_usage=LLMUsage(calls=2, prompt_tokens=100, completion_tokens=20, cost_usd=0.001),
+    )
+
+
+def slow_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """``deterministic_episode`` after a short sleep (for kill-and-resume tests and benchmarks)."""
+    time.sleep(float(os.environ.get("FAKE_EPISODE_SECONDS", "0.15")))
+    return deterministic_episode(spec, out_dir=out_dir)
+
+
+def raising_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """Raises for tasks whose name contains 'bad', else ``deterministic_episode``."""
+    if "bad" in spec.task:
+        raise RuntimeError(f"simulated failure in {spec.task}")
+    return deterministic_episode(spec, out_dir=out_dir)
+
+
+def dying_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """Kills its own worker process for tasks named 'die', else ``deterministic_episode``."""
+    if spec.task == "die":
+        os._exit(3)
+    return deterministic_episode(spec, out_dir=out_dir)
+
+
+def limited_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """Holds the worker's LLM limiter for 0.2 s while counting holders via marker files.
+
+    The record's ``timings['holders']`` is the most holders seen at once (1 when the limit is 1).
+    """
+    from more_agent.eval.limits import llm_limiter
+
+    assert out_dir is not None
+    marks = out_dir.parent / "_llm_marks"
+    marks.mkdir(exist_ok=True)
+    mine = marks / out_dir.name
+    with llm_limiter():
+        mine.touch()
+        holders = len(list(marks.iterdir()))
+        time.sleep(0.2)
+        holders = max(holders, len(list(marks.iterdir())))
+        mine.unlink()
+    rec = deterministic_episode(spec, out_dir=out_dir)
+    return rec.model_copy(update={"timings": {"holders": float(holders)}})

@@ -1,0 +1,106 @@
+"""Metric definitions on hand-made records: SR, TTC, TP, rTP, intervals, grouping."""
+
+from __future__ import annotations
+
+import pytest
+
+from more_agent.eval.metrics import (
+    bootstrap_interval,
+    by_system,
+    by_task,
+    estimate,
+    rtp,
+    sr,
+    summarize,
+    system_label,
+    tp,
+    ttc,
+    wilson_interval,
+)
+from more_agent.eval.record import EpisodeRecord, GoalCondition
+
+
+def rec(task: str = "t", *, conds: list[tuple[bool, list[str]]] = (), observed: list[str] = (), **kw) -> EpisodeRecord:
+    goal = [GoalCondition(text=f"c{i}", satisfied=s, objects=o) for i, (s, o) in enumerate(conds)]
+    met = sum(c.satisfied for c in goal)
+    defaults = dict(
+        task=task,
+        scene="Rs_int",
+        seed=0,
+        planner="more",
+        goal_conditions=goal,
+        observed_objects=list(observed),
+        task_progress=met / len(goal) if goal else 0.0,
+        all_goals_met=bool(goal) and met == len(goal),
+    )
+    return EpisodeRecord(**{**defaults, **kw})
+
+
+def test_sr_needs_done_but_ttc_does_not() -> None:
+    all_met_no_done = rec(conds=[(True, ["a"])], done_called=False, success=False)
+    all_met_done = rec(conds=[(True, ["a"])], done_called=True, success=True)
+    assert (sr(all_met_no_done), ttc(all_met_no_done)) == (0.0, 1.0)
+    assert (sr(all_met_done), ttc(all_met_done)) == (1.0, 1.0)
+
+
+def test_tp_is_share_of_conditions_met() -> None:
+    r = rec(conds=[(True, ["a"]), (False, ["b"]), (True, ["c"]), (False, ["d"])])
+    assert tp(r) == pytest.approx(0.5)
+
+
+def test_rtp_counts_only_conditions_whose_objects_were_all_observed() -> None:
+    r = rec(
+        conds=[(True, ["a", "table"]), (False, ["b", "table"]), (False, ["c", "table"]), (True, ["d", "shelf"])],
+        observed=["a", "b", "table", "d"],  # 'shelf' unseen -> condition 3 excluded; 'c' unseen -> 2 excluded
+    )
+    assert rtp(r) == pytest.approx(1 / 2)
+    assert tp(r) == pytest.approx(2 / 4)
+
+
+def test_rtp_is_zero_when_nothing_observed_and_condition_without_objects_counts() -> None:
+    assert rtp(rec(conds=[(True, ["a"]), (True, ["b"])], observed=[])) == 0.0
+    assert rtp(rec(conds=[], observed=["a"])) == 0.0
+    assert rtp(rec(conds=[(True, []), (False, ["x"])], observed=[])) == 1.0
+
+
+def test_wilson_interval_known_values() -> None:
+    assert wilson_interval(0, 10) == pytest.approx((0.0, 0.27753), abs=1e-4)
+    assert wilson_interval(5, 10) == pytest.approx((0.23659, 0.76341), abs=1e-4)
+    assert wilson_interval(10, 10)[1] == pytest.approx(1.0)
+    assert wilson_interval(0, 0) == (0.0, 1.0)
+
+
+def test_bootstrap_interval_deterministic_and_brackets_mean() -> None:
+    values = [0.0, 0.25, 0.5, 1.0, 1.0, 0.75, 0.0, 0.5]
+    lo, hi = bootstrap_interval(values)
+    assert (lo, hi) == bootstrap_interval(values)
+    assert lo < sum(values) / len(values) < hi
+    assert bootstrap_interval([0.4, 0.4, 0.4]) == pytest.approx((0.4, 0.4))
+
+
+def test_estimate_methods_and_counts() -> None:
+    records = [rec(conds=[(True, ["a"])], success=True), rec(conds=[(False, ["a"])]), rec(conds=[(True, ["a"])])]
+    e = estimate(records, "SR")
+    assert (e.mean, e.n, e.method) == (pytest.approx(1 / 3), 3, "wilson")
+    assert estimate(records, "TP").method == "bootstrap"
+    assert estimate(records, "TTC").mean == pytest.approx(2 / 3)
+
+
+def test_summaries_per_system_and_task_count_errors() -> None:
+    records = [
+        rec("t1", conds=[(True, ["a"])], success=True, planner="more", llm="openai:gpt-4o"),
+        rec("t2", conds=[(False, ["a"])], planner="more", llm="openai:gpt-4o", error="RuntimeError: boom"),
+        rec("t1", conds=[(True, ["a"])], planner="oracle"),
+    ]
+    systems = by_system(records)
+    assert list(systems) == ["more (openai:gpt-4o)", "oracle"]
+    more = systems["more (openai:gpt-4o)"]
+    assert (more.n, more.n_tasks, more.n_errors, more.SR.mean) == (2, 2, 1, 0.5)
+    assert set(by_task(records)) == {("more (openai:gpt-4o)", "t1"), ("more (openai:gpt-4o)", "t2"), ("oracle", "t1")}
+    assert system_label(records[2]) == "oracle"
+    assert summarize([]).n == 0
+
+
+def test_estimates_do_not_depend_on_record_order() -> None:
+    records = [rec(f"t{i}", conds=[(i % 3 == 0, ["a"]), (i % 2 == 0, ["b"])], observed=["a"]) for i in range(9)]
+    assert summarize(records) == summarize(records[::-1])

@@ -1,0 +1,114 @@
+"""Reports: Table I markdown, CSV, HTML escaping and thumbnails, merging runs, the CLI commands."""
+
+from __future__ import annotations
+
+import base64
+import csv
+import io
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from more_agent.cli import app
+from more_agent.eval.record import ActionRecord, EpisodeRecord, GoalCondition
+from more_agent.eval.report import SourcedRecord, load_runs, summary_csv, summary_markdown, write_reports
+from more_agent.eval.store import EpisodeWriter, episode_dirname
+from more_agent.viz.report_html import render_report
+
+PNG = base64.b64decode(
+    "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNk+M9QDwADhgGAWjR9awAAAABJRU5ErkJggg=="
+)
+EVIL = "<script>alert(1)</script>"
+
+
+def rec(task: str, planner: str = "more", **kw: object) -> EpisodeRecord:
+    return EpisodeRecord(
+        task=task,
+        scene="Rs_int",
+        seed=0,
+        planner=planner,
+        llm="openai:gpt-4o" if planner != "oracle" else None,
+        goal_conditions=[GoalCondition(text="(open fridge_1)", satisfied=True, objects=["fridge_1"])],
+        observed_objects=["fridge_1"],
+        task_progress=1.0,
+        all_goals_met=True,
+        trajectory=[(0.0, 0.0), (1.5, 2.0)],
+        **kw,
+    )
+
+
+def make_run(d: Path, records: list[EpisodeRecord]) -> Path:
+    d.mkdir(parents=True)
+    with EpisodeWriter(d / "episodes.jsonl") as w:
+        for r in records:
+            w.append(r)
+    return d
+
+
+def test_markdown_and_csv_have_a_row_per_system_and_task() -> None:
+    records = [rec("t1", success=True), rec("t2"), rec("t1", "oracle", success=True)]
+    md = summary_markdown(records)
+    assert "| more (openai:gpt-4o) | 2 | 2 | 0 | 50.0 [" in md and "| oracle | 1 | 1 | 0 | 100.0 [" in md
+    rows = list(csv.DictReader(io.StringIO(summary_csv(records))))
+    assert [(r["system"], r["task"]) for r in rows] == [
+        ("more (openai:gpt-4o)", "ALL"),
+        ("oracle", "ALL"),
+        ("more (openai:gpt-4o)", "t1"),
+        ("more (openai:gpt-4o)", "t2"),
+        ("oracle", "t1"),
+    ]
+    assert float(rows[0]["SR"]) == 0.5 and float(rows[0]["SR_low"]) < 0.5 < float(rows[0]["SR_high"])
+
+
+def test_html_escapes_all_record_text(tmp_path: Path) -> None:
+    evil = rec(
+        f"task{EVIL}",
+        description=EVIL,
+        actions=[ActionRecord(step=0, name=EVIL, arguments=[EVIL], ok=False, feedback=f"failed: {EVIL}")],
+        error=EVIL,
+        traceback=EVIL,
+    )
+    html = render_report([SourcedRecord(evil, tmp_path)])
+    assert "<script>" not in html
+    assert html.count("&lt;script&gt;alert(1)&lt;/script&gt;") >= 6
+
+
+def test_thumbnail_embeds_map_png_else_draws_trajectory(tmp_path: Path) -> None:
+    with_map, without = rec("t1"), rec("t2")
+    ep_dir = tmp_path / "episodes" / episode_dirname("t1", None, 0, "more")
+    ep_dir.mkdir(parents=True)
+    (ep_dir / "map.png").write_bytes(PNG)
+    html = render_report([SourcedRecord(with_map, tmp_path), SourcedRecord(without, tmp_path)])
+    assert html.count("data:image/png;base64," + base64.b64encode(PNG).decode()) == 1
+    assert html.count("<polyline") == 1
+
+
+def test_load_runs_merges_and_drops_duplicates(tmp_path: Path) -> None:
+    a = make_run(tmp_path / "a", [rec("t1"), rec("t2")])
+    b = make_run(tmp_path / "b", [rec("t1", success=True), rec("t1", "oracle")])
+    sourced, dropped = load_runs([a, b])
+    assert dropped == 1
+    assert [(s.record.planner, s.record.task, s.run_dir.name) for s in sourced] == [
+        ("more", "t1", "a"),
+        ("more", "t2", "a"),
+        ("oracle", "t1", "b"),
+    ]
+    paths = write_reports(sourced, tmp_path / "out")
+    assert all(p.stat().st_size > 0 for p in paths)
+
+
+def test_cli_eval_then_report(tmp_path: Path) -> None:
+    runner = CliRunner()
+    args = ["eval", "--tasks", "a,bad", "--planner", "oracle", "--seeds", "2", "--no-progress"]
+    args += ["--episode-fn", "tests.eval.fake_episodes:raising_episode", "--out", str(tmp_path / "run")]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "| oracle | 4 | 2 | 2 |" in result.output
+    assert {p.name for p in (tmp_path / "run").iterdir()} >= {"episodes.jsonl", "run.json", "summary.md", "summary.csv", "report.html"}
+    again = runner.invoke(app, args)
+    assert again.exit_code == 2 and "--resume" in again.output
+    report = runner.invoke(app, ["report", str(tmp_path / "run"), "--per-task", "--out", str(tmp_path / "cmp")])
+    assert report.exit_code == 0 and "| oracle | bad | 2 | 2 |" in report.output
+    assert (tmp_path / "cmp" / "report.html").is_file()
+    missing = runner.invoke(app, ["report", str(tmp_path / "nothing")])
+    assert missing.exit_code == 2

@@ -1,0 +1,95 @@
+"""episodes.jsonl durability (torn lines), run directories, resume bookkeeping."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from more_agent.errors import UserError
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.store import (
+    EpisodeWriter,
+    RunConfig,
+    TornStoreError,
+    episode_dirname,
+    pending,
+    prepare_run_dir,
+    read_records,
+    read_run_config,
+    redact,
+)
+
+
+def rec(task: str, seed: int = 0, scene: str = "Rs_int") -> EpisodeRecord:
+    return EpisodeRecord(task=task, scene=scene, seed=seed, planner="oracle")
+
+
+def write(path: Path, records: list[EpisodeRecord]) -> None:
+    with EpisodeWriter(path) as w:
+        for r in records:
+            w.append(r)
+
+
+def config(**kw: object) -> RunConfig:
+    return RunConfig(**{"planner": "oracle", "tasks": ["a"], "seeds": [0], "episode_fn": "m:f", **kw})
+
+
+def test_roundtrip_one_line_per_record(tmp_path: Path) -> None:
+    p = tmp_path / "episodes.jsonl"
+    write(p, [rec("a"), rec("b", 1)])
+    assert p.read_text().count("\n") == 2
+    assert [r.key() for r in read_records(p)] == [("a", "Rs_int", 0, "oracle"), ("b", "Rs_int", 1, "oracle")]
+    assert read_records(tmp_path) == read_records(p)
+    assert read_records(tmp_path / "missing.jsonl") == []
+
+
+@pytest.mark.parametrize("tail", [b'{"task": "c", "sce', b'{"task":"x"}', rec("c").model_dump_json().encode()])
+def test_torn_last_line_is_dropped_and_repaired(tmp_path: Path, tail: bytes) -> None:
+    p = tmp_path / "episodes.jsonl"
+    write(p, [rec("a"), rec("b")])
+    good = p.read_bytes()
+    p.write_bytes(good + tail)
+    assert [r.task for r in read_records(p)] == ["a", "b"]
+    assert p.read_bytes() == good + tail  # reading alone does not modify
+    read_records(p, repair=True)
+    assert p.read_bytes() == good
+    write(p, [rec("c")])
+    assert [r.task for r in read_records(p)] == ["a", "b", "c"]
+
+
+def test_bad_line_in_the_middle_is_an_error(tmp_path: Path) -> None:
+    p = tmp_path / "episodes.jsonl"
+    p.write_bytes(rec("a").model_dump_json().encode() + b"\nnot json\n" + rec("b").model_dump_json().encode() + b"\n")
+    with pytest.raises(TornStoreError, match="unreadable record"):
+        read_records(p)
+
+
+def test_prepare_refuses_non_empty_dir_without_resume(tmp_path: Path) -> None:
+    (tmp_path / "something").write_text("x")
+    with pytest.raises(UserError, match="not empty.*--resume"):
+        prepare_run_dir(tmp_path, config(), resume=False)
+
+
+def test_prepare_resume_checks_planner_and_returns_records(tmp_path: Path) -> None:
+    assert prepare_run_dir(tmp_path / "run", config(), resume=False) == []
+    write(tmp_path / "run" / "episodes.jsonl", [rec("a")])
+    assert read_run_config(tmp_path / "run") == config()
+    with pytest.raises(UserError, match="cannot resume"):
+        prepare_run_dir(tmp_path / "run", config(planner="more", llm="openai:gpt-4o"), resume=True)
+    assert [r.task for r in prepare_run_dir(tmp_path / "run", config(tasks=["a", "b"]), resume=True)] == ["a"]
+    assert read_run_config(tmp_path / "run").tasks == ["a", "b"]
+
+
+def test_pending_matches_unset_scene_to_any_scene() -> None:
+    specs = [EpisodeSpec(task=t, seed=s) for t in ("a", "b") for s in (0, 1)]
+    done = [rec("a", 0, "Rs_int"), rec("b", 1, "Beechwood_0_int")]
+    assert [(s.task, s.seed) for s in pending(specs, done)] == [("a", 1), ("b", 0)]
+    pinned = [EpisodeSpec(task="a", scene="Pomaria_1_int", seed=0)]
+    assert pending(pinned, done) == pinned
+
+
+def test_redact_and_dirname() -> None:
+    assert redact("openai:gpt-4o?api_key=sk-123&base=x") == "openai:gpt-4o?api_key=***&base=x"
+    assert redact(None) is None
+    assert episode_dirname("a/b", None, 3, "more") == "a_b__auto__s3__more"

@@ -1,0 +1,193 @@
+"""A real local HTTP server speaking the OpenAI chat-completions API, driven by a script.
+
+Each POST to ``/v1/chat/completions`` takes the next script item: a :class:`Reply` (text answer with
+usage), a :class:`Status` (HTTP error, optional ``retry-after``), a :class:`Delay` (wait, then serve
+another item; makes clients time out) or :class:`Close` (drop the connection without answering).
+A plain string in a script is a Reply. Requests are recorded in ``server.requests``. Binds to
+127.0.0.1 on a free port; use it as a context manager::
+
+    with FakeOpenAIServer(["{\"room\": \"kitchen\"}", Status(429, retry_after=0)]) as server:
+        ...  # point the client at server.base_url
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections import deque
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Reply:
+    """A successful chat completion with this text and usage."""
+
+    text: str
+    prompt_tokens: int = 100
+    completion_tokens: int = 20
+    model: str | None = None
+    """Model name in the response; None echoes the requested model."""
+
+
+@dataclass(frozen=True)
+class Status:
+    """An HTTP error status with an OpenAI-style error body."""
+
+    code: int
+    message: str = "fake error"
+    retry_after: float | None = None
+
+
+@dataclass(frozen=True)
+class Delay:
+    """Wait ``seconds`` (cut short when the server stops), then serve ``then``."""
+
+    seconds: float
+    then: Reply | Status = field(default_factory=lambda: Reply("{}"))
+
+
+@dataclass(frozen=True)
+class Close:
+    """Drop the connection without sending a response."""
+
+
+ScriptItem = Reply | Status | Delay | Close
+
+
+@dataclass(frozen=True)
+class RecordedRequest:
+    """One request the server received."""
+
+    path: str
+    headers: dict[str, str]
+    """Header names in lower case."""
+    body: dict[str, Any]
+
+
+EXHAUSTED = Status(500, "fake server: script exhausted")
+
+
+class FakeOpenAIServer:
+    """Scripted OpenAI-compatible server on 127.0.0.1; ``default`` answers once the script is used up."""
+
+    def __init__(self, script: Iterable[ScriptItem | str] = (), *, default: ScriptItem | str = EXHAUSTED) -> None:
+        self._script: deque[ScriptItem] = deque()
+        self.push(*script)
+        self._default = Reply(default) if isinstance(default, str) else default
+        self.requests: list[RecordedRequest] = []
+        self._lock = threading.Lock()
+        self._stopped = threading.Event()
+        self._httpd: ThreadingHTTPServer | None = None
+        self._thread: threading.Thread | None = None
+
+    def push(self, *items: ScriptItem | str) -> None:
+        """Append items to the script."""
+        self._script.extend(Reply(i) if isinstance(i, str) else i for i in items)
+
+    @property
+    def port(self) -> int:
+        """The bound port (after start)."""
+        assert self._httpd is not None, "server not started"
+        return self._httpd.server_address[1]
+
+    @property
+    def base_url(self) -> str:
+        """What to give a client as base URL."""
+        return f"http://127.0.0.1:{self.port}/v1"
+
+    def _next(self, request: RecordedRequest) -> ScriptItem:
+        with self._lock:
+            self.requests.append(request)
+            return self._script.popleft() if self._script else self._default
+
+    def start(self) -> FakeOpenAIServer:
+        """Bind and serve in a daemon thread."""
+        server = self
+        handler = type("Handler", (_Handler,), {"fake": server})
+        self._httpd = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+        self._httpd.daemon_threads = True
+        self._httpd.block_on_close = False
+        self._thread = threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """Stop serving and free the port (pending delays end at once)."""
+        self._stopped.set()
+        if self._httpd is not None:
+            self._httpd.shutdown()
+            self._httpd.server_close()
+        if self._thread is not None:
+            self._thread.join(timeout=5)
+
+    def __enter__(self) -> FakeOpenAIServer:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+class _Handler(BaseHTTPRequestHandler):
+    protocol_version = "HTTP/1.1"
+    fake: FakeOpenAIServer
+
+    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - stdlib signature
+        """Silence the default stderr log."""
+
+    def _send_json(self, code: int, body: dict[str, Any], headers: dict[str, str] | None = None) -> None:
+        data = json.dumps(body).encode()
+        try:
+            self.send_response(code)
+            self.send_header("Content-Type", "application/json")
+            self.send_header("Content-Length", str(len(data)))
+            for k, v in (headers or {}).items():
+                self.send_header(k, v)
+            self.end_headers()
+            self.wfile.write(data)
+        except (BrokenPipeError, ConnectionResetError):
+            self.close_connection = True
+
+    def _serve(self, item: ScriptItem, body: dict[str, Any]) -> None:
+        if isinstance(item, Delay):
+            self.fake._stopped.wait(item.seconds)
+            self._serve(item.then, body)
+        elif isinstance(item, Close):
+            self.close_connection = True
+        elif isinstance(item, Status):
+            headers = {"retry-after": f"{item.retry_after:g}"} if item.retry_after is not None else {}
+            self._send_json(item.code, {"error": {"message": item.message, "type": "fake", "code": None}}, headers)
+        else:
+            self._send_json(
+                200,
+                {
+                    "id": f"chatcmpl-fake-{len(self.fake.requests)}",
+                    "object": "chat.completion",
+                    "created": int(time.time()),
+                    "model": item.model or body.get("model", "fake-model"),
+                    "choices": [
+                        {"index": 0, "message": {"role": "assistant", "content": item.text}, "finish_reason": "stop"}
+                    ],
+                    "usage": {
+                        "prompt_tokens": item.prompt_tokens,
+                        "completion_tokens": item.completion_tokens,
+                        "total_tokens": item.prompt_tokens + item.completion_tokens,
+                    },
+                },
+            )
+
+    def do_POST(self) -> None:
+        raw = self.rfile.read(int(self.headers.get("Content-Length", 0)))
+        if self.path.rstrip("/") != "/v1/chat/completions":
+            self._send_json(404, {"error": {"message": f"no route {self.path}", "type": "fake", "code": None}})
+            return
+        try:
+            body = json.loads(raw or b"{}")
+        except json.JSONDecodeError:
+            self._send_json(400, {"error": {"message": "body is not JSON", "type": "fake", "code": None}})
+            return
+        item = self.fake._next(RecordedRequest(self.path, {k.lower(): v for k, v in self.headers.items()}, body))
+        self._serve(item, body)
