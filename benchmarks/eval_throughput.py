@@ -70,7 +70,9 @@ def main() -> None:
     a = p.parse_args()
     tasks = resolve_tasks(a.tasks) if a.tasks else [f"task{i}" for i in range(a.episodes)]
     for backend in a.backends:
-        for workers in [1] if backend == "inline" else a.workers:
+        # one worker means inline in the harness, so the process pool is measured from two workers up
+        counts = [1] if backend == "inline" else [w for w in a.workers if backend == "ray" or w > 1]
+        for workers in counts:
             print(json.dumps(measure(backend, workers, tasks, a.seeds, a.episode_fn, a.planner)), flush=True)
 
 

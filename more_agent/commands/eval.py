@@ -33,16 +33,19 @@ def eval_(
 ) -> None:
     """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl."""
     from more_agent import __version__
-    from more_agent.eval.harness import DEFAULT_EPISODE_FN, evaluate, resolve_tasks
+    from more_agent.eval.harness import DEFAULT_EPISODE_FN, check_task_names, evaluate, resolve_tasks
     from more_agent.eval.report import load_runs, table_i_markdown, write_reports
     from more_agent.eval.store import RunConfig, redact
 
     if llm is not None and llm != redact(llm):
         raise UserError("--llm must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
+    names = resolve_tasks(tasks)
+    if episode_fn is None:  # the real episode function runs BEHAVIOR-1K activities: check the names now
+        check_task_names(names)
     config = RunConfig(
         planner=planner,
         llm=llm,
-        tasks=resolve_tasks(tasks),
+        tasks=names,
         seeds=list(range(seeds)),
         scene=scene,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,

@@ -1,6 +1,75 @@
-"""``more-agent run TASK``: run one episode. (Owned by the episode work.)"""
+"""``more-agent run TASK``: run one episode and write ``DIR/episode.json`` and ``DIR/map.png``.
+
+Bad input (unknown task, scene or planner; a task that cannot be instantiated in the asked scene)
+ends with one error line and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from more_agent.commands._common import console, user_errors_exit_2
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+
+RUNS_DIR = Path("runs")
+"""Parent of the default output folders."""
 
 
-def run(task: str) -> None:
-    """Run one episode of TASK."""
-    raise NotImplementedError
+def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Path:
+    """``runs/<task>-<scene>-<seed>-<planner>``; the scene is the task's first suitable one when not given."""
+    if scene is None:
+        from more_agent.sim.tasks import suitable_scenes
+
+        scenes = suitable_scenes(task)
+        scene = scenes[0] if scenes else "auto"
+    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", f"{task}-{Path(scene).stem}-{seed}-{planner}")
+    return RUNS_DIR / name
+
+
+def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
+    """A short summary of an episode for the terminal."""
+    table = Table(show_header=False, box=None, pad_edge=False)
+    table.add_column(style="bold")
+    table.add_column()
+    verdict = "[green]success[/]" if record.success else "[red]failure[/]"
+    table.add_row("episode", f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}")
+    table.add_row("result", f"{verdict}; goals met: {record.all_goals_met}; done called: {record.done_called}")
+    met = sum(c.satisfied for c in record.goal_conditions)
+    table.add_row("progress", f"{record.task_progress:.2f} ({met}/{len(record.goal_conditions)} goal conditions)")
+    table.add_row("steps", f"{record.high_level_steps} high-level, {record.low_level_steps} low-level")
+    table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
+    if record.error:
+        table.add_row("why", record.error)
+    table.add_row("files", f"{out_dir / 'episode.json'}, {out_dir / 'map.png'}")
+    return table
+
+
+@user_errors_exit_2
+def run(
+    task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
+    planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
+    scene: Annotated[str | None, typer.Option(help="Scene name or scene .json file (default: the task's first suitable scene).")] = None,
+    seed: Annotated[int, typer.Option(help="Seed of scene generation and task instantiation.")] = 0,
+    out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
+    save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
+    save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
+    llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
+) -> None:
+    """Run one episode of TASK and write its record and map."""
+    from more_agent.eval.episode import run_episode
+    from more_agent.planners.base import default_planner, make_planner
+
+    planner = planner or default_planner(llm)
+    make_planner(planner, llm)  # validates the name before any work
+    out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
+    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=llm)
+    with console.status(f"running {task} with planner {planner} ..."):
+        record = run_episode(spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True)
+    console.print(summary_table(record, out_dir))
+    if record.traceback:
+        raise typer.Exit(code=1)

@@ -1,5 +1,80 @@
-"""``more-agent scene ...``: list, generate, render scenes. (Owned by the scenes work.)"""
+"""``more-agent scene ...``: list, show, generate and render BEHAVIOR-1K scenes (or a scene JSON file)."""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
 
 import typer
+from rich.table import Table
 
-app = typer.Typer(help="BEHAVIOR-1K scenes: list, generate, render.", no_args_is_help=True)
+from more_agent.commands._common import console, user_errors_exit_2
+
+app = typer.Typer(help="BEHAVIOR-1K scenes: list, show, generate, render.", no_args_is_help=True)
+
+SCENE_ARG = typer.Argument(..., help="Scene name (e.g. Rs_int) or a path to a scene .json file.")
+SEED_OPT = typer.Option(0, "--seed", help="Layout seed; same scene and seed give the same plan.")
+
+
+@app.command("list")
+@user_errors_exit_2
+def list_() -> None:
+    """List the 51 BEHAVIOR-1K scenes with their rooms."""
+    from more_agent.sim import catalog
+
+    table = Table("scene", "rooms", "room ids")
+    for name in catalog.scene_names():
+        rooms = list(catalog.scene_rooms(name))
+        table.add_row(name, str(len(rooms)), ", ".join(rooms))
+    console.print(table)
+
+
+@app.command("show")
+@user_errors_exit_2
+def show(scene: str = SCENE_ARG, seed: int = SEED_OPT) -> None:
+    """Rooms (type, area, ground, doors), doors and furniture counts of a generated plan."""
+    from more_agent.sim.scenes import get_scene
+
+    s = get_scene(scene, seed)
+    console.print(f"[bold]{s.name}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
+                  f"{len(s.windows)} windows, {len(s.furniture)} furniture, {len(s.walls)} wall boxes")
+    rooms = Table("room", "type", "area m²", "ground", "outdoor", "doors to", "furniture")
+    for r in s.rooms:
+        area = (r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1])
+        links = [f"{d.id}:{next(x for x in d.rooms if x != r.id)}{'' if d.open else ' (closed)'}"
+                 for d in s.doors if r.id in d.rooms]
+        counts = Counter(f.category for f in s.furniture if f.room == r.id)
+        rooms.add_row(r.id, r.type, f"{area:.1f}", r.ground, "yes" if r.outdoor else "",
+                      ", ".join(links), ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())))
+    console.print(rooms)
+
+
+@app.command("generate")
+@user_errors_exit_2
+def generate(
+    scene: str = SCENE_ARG,
+    seed: int = SEED_OPT,
+    out: Path = typer.Option(..., "--out", help="Where to write the scene JSON."),
+) -> None:
+    """Write a generated plan as scene JSON (the format a user can also write by hand)."""
+    from more_agent.sim.scene import save_scene
+    from more_agent.sim.scenes import get_scene
+
+    save_scene(get_scene(scene, seed), out)
+    console.print(f"wrote {out}")
+
+
+@app.command("render")
+@user_errors_exit_2
+def render(
+    scene: str = SCENE_ARG,
+    seed: int = SEED_OPT,
+    out: Path = typer.Option(..., "--out", help="Where to write the PNG."),
+    labels: bool = typer.Option(False, "--labels", help="Write furniture ids on the plan."),
+) -> None:
+    """Draw the plan: rooms labelled, ground classes, walls, windows, open / closed doors, furniture."""
+    from more_agent.sim.scenes import get_scene
+    from more_agent.viz.plan import plot_plan
+
+    plot_plan(get_scene(scene, seed), out, label_furniture=labels)
+    console.print(f"wrote {out}")

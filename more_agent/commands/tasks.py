@@ -1,5 +1,68 @@
-"""``more-agent tasks ...``: list and show tasks. (Owned by the tasks work.)"""
+"""``more-agent tasks list [--set NAME]`` and ``more-agent tasks show TASK [--scene S] [--seed N]``."""
+
+from __future__ import annotations
+
+from typing import Annotated
 
 import typer
+from rich.table import Table
+
+from more_agent.commands._common import console, user_errors_exit_2
 
 app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.", no_args_is_help=True)
+
+
+@app.command("list")
+@user_errors_exit_2
+def list_(
+    set_: Annotated[str | None, typer.Option("--set", help="Task set: 'more-paper' or 'behavior-rearrange'.")] = None,
+) -> None:
+    """List tasks (all 1016 activities, or one task set) with objects, goal literals, status and scenes."""
+    from more_agent.sim.tasks import task_data, task_names, task_set
+
+    names = task_set(set_) if set_ is not None else task_names()
+    data = task_data()["tasks"]
+    table = Table(title=f"{len(names)} tasks" + (f" in {set_}" if set_ else ""))
+    for col in ("task", "objects", "goal literals", "instantiable", "scenes"):
+        table.add_column(col)
+    for name in names:
+        e = data[name]
+        scenes = e["scenes"]
+        shown = ", ".join(scenes[:3]) + (f" (+{len(scenes) - 3})" if len(scenes) > 3 else "")
+        table.add_row(name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-")
+    console.print(table)
+
+
+@app.command("show")
+@user_errors_exit_2
+def show(
+    task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
+    scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: the first suitable).")] = None,
+    seed: Annotated[int, typer.Option(help="Seed of scene generation and instantiation.")] = 0,
+) -> None:
+    """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
+    from more_agent.sim.instantiate import instantiate, literal_text
+    from more_agent.sim.tasks import load_task, suitable_scenes
+
+    definition = load_task(task)
+    scenes = suitable_scenes(task)
+    console.print(f"[bold]{task}[/]", highlight=False)
+    console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False)
+    console.print("goal:", highlight=False)
+    for lit in definition.goal:
+        console.print(f"  {literal_text(lit)}", highlight=False, markup=False)
+    if not scenes and scene is None:
+        return
+    inst = instantiate(task, scene, seed)
+    console.print(f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False)
+    console.print(f"description: {inst.description}", highlight=False, markup=False)
+    table = Table(title="objects")
+    for col in ("scope", "world object", "label", "category", "where"):
+        table.add_column(col)
+    for s, name in inst.scope.items():
+        obj = inst.world.objects.get(name)
+        where = f"{obj.relation} {obj.parent}" if obj is not None and obj.parent else (obj.room or "") if obj else ""
+        table.add_row(s, name, inst.label(s), obj.category if obj else "-", where)
+    console.print(table)
+    if inst.unsupported_literals:
+        console.print("init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False)

@@ -24,7 +24,7 @@ from pathlib import Path
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-from more_agent.errors import UserError
+from more_agent.errors import UserError, unknown_name_error
 from more_agent.eval.limits import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.eval.store import (
@@ -40,9 +40,6 @@ from more_agent.eval.store import (
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
 
-TASK_SETS = ("more-paper", "behavior-rearrange")
-"""Task-set names ``--tasks`` accepts; resolved by ``more_agent.sim.tasks.task_set``."""
-
 DEFAULT_MAX_RETRIES = 2
 """Re-runs of an episode whose worker process died before it is recorded as an error."""
 
@@ -54,9 +51,19 @@ EpisodeFn = Callable[..., EpisodeRecord]
 
 
 def _default_task_set(name: str) -> list[str]:
-    from more_agent.sim.tasks import task_set  # lazy: the simulator is heavy and not needed here
+    from more_agent.sim.tasks import task_set  # lazy: workers need no task catalogue
 
     return list(task_set(name))
+
+
+def check_task_names(names: Iterable[str]) -> None:
+    """Raise a UserError naming the closest activities for the first unknown task name."""
+    from more_agent.sim.tasks import task_names
+
+    known = set(task_names())
+    for name in names:
+        if name not in known:
+            raise unknown_name_error("task", name, sorted(known))
 
 
 def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = None) -> list[str]:
@@ -64,6 +71,8 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
 
     Duplicates are dropped, order kept. Lines starting with '#' in a file are comments.
     """
+    from more_agent.sim.tasks import TASK_SETS
+
     arg = arg.strip()
     path = Path(arg)
     if arg in TASK_SETS:

@@ -145,7 +145,8 @@ class ChatClient:
         }
         key = request_key(key_fields)
         start = time.perf_counter()
-        hit = self.cache.get(key) if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REPLAY) else None
+        reads = self.cache_mode in (CacheMode.ON, CacheMode.REPLAY)
+        hit = self.cache.get(key) if reads and self.cache is not None else None
         if hit is None and self.cache_mode is CacheMode.REPLAY:
             raise ReplayMiss(key=key, model=self.backend.model, purpose=purpose)
         if hit is not None:
@@ -156,8 +157,10 @@ class ChatClient:
             attempts = gen.attempts
             if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REFRESH):
                 self.cache.put(key, request=key_fields, purpose=purpose, answer=answer)
-        completion = self._completion(answer, request, cached=hit is not None, attempts=attempts, purpose=purpose,
-                                      latency_s=time.perf_counter() - start)
+        completion = self._completion(
+            answer, request, cached=hit is not None, attempts=attempts, purpose=purpose,
+            latency_s=time.perf_counter() - start,
+        )
         self.usage.add(completion)
         log.debug(
             "llm %s model=%s tokens=%d+%d cost=%.5f cached=%s latency=%.2fs attempts=%d",
@@ -165,12 +168,20 @@ class ChatClient:
             completion.cost_usd, completion.cached, completion.latency_s, completion.attempts,
         )
         if request.schema is not None and completion.parsed is None:
-            raise Unparseable(f"no JSON object in the answer to {purpose or 'a request'}: {answer.text[:200]!r}",
-                              completion=completion)
+            raise Unparseable(
+                f"no JSON object in the answer to {purpose or 'a request'}: {answer.text[:200]!r}", completion=completion
+            )
         return completion
 
     def _completion(
-        self, answer: CachedAnswer, request: ChatRequest, *, cached: bool, attempts: int, purpose: str, latency_s: float
+        self,
+        answer: CachedAnswer,
+        request: ChatRequest,
+        *,
+        cached: bool,
+        attempts: int,
+        purpose: str,
+        latency_s: float,
     ) -> Completion:
         """The Completion for an answer: JSON extracted if asked for, cost from the price table."""
         if self.backend.free:

@@ -64,10 +64,11 @@ class LLMConfig(BaseModel):
     )
     room_model: str | None = Field(
         default=None,
-        description="Cheaper model for room classification on the same endpoint (paper: gpt-3.5-turbo); None = same model.",
+        description="Cheaper model for room classification, same endpoint (paper: gpt-3.5-turbo); None = same model.",
     )
     base_url: str | None = Field(
-        default=None, description="OpenAI-compatible endpoint (OpenAI, Azure, vLLM, Ollama, llama.cpp); None = OpenAI's."
+        default=None,
+        description="OpenAI-compatible endpoint (OpenAI, Azure, vLLM, Ollama, llama.cpp); None = OpenAI's.",
     )
     api_key: SecretStr | None = Field(
         default=None, description="API key; better taken from OPENAI_API_KEY. Never written to caches or logs."

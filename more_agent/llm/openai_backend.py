@@ -143,6 +143,11 @@ class OpenAIBackend:
             max_tokens=request.max_tokens,
             **extra,
         )
+        if not hasattr(resp, "choices"):
+            raise LLMServerError(
+                f"{self.base_url} answered with something that is not a chat completion: {str(resp)[:200]!r}",
+                status_code=200,
+            )
         text = (resp.choices[0].message.content or "") if resp.choices else ""
         usage = resp.usage
         return Generation(
@@ -162,12 +167,13 @@ class OpenAIBackend:
             attempts += 1
             with_schema = request.schema is not None and self.schema_supported
             retry_after: float | None = None
+            error: LLMTransportError
             try:
                 gen = self._create(request, with_schema)
                 return Generation(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens, attempts)
             except openai.BadRequestError as e:
                 if with_schema and self.structured_output is StructuredOutput.AUTO:
-                    log.warning("%s rejected response_format (%s); parsing JSON from text from now on", self.base_url, e)
+                    log.warning("%s rejected response_format (%s); parsing JSON from text now", self.base_url, e)
                     self.schema_supported = False
                     continue
                 raise LLMBadRequest(
@@ -179,8 +185,14 @@ class OpenAIBackend:
                     status_code=e.status_code,
                     attempts=attempts,
                 ) from None
+            except LLMServerError as e:
+                error = LLMServerError(str(e), status_code=e.status_code, attempts=attempts)
+            except openai.APIResponseValidationError as e:
+                error = LLMServerError(
+                    f"{self.base_url} sent an invalid chat completion: {e}", status_code=e.status_code, attempts=attempts
+                )
             except openai.APITimeoutError:
-                error: LLMTransportError = LLMTimeout(
+                error = LLMTimeout(
                     f"{self.model} at {self.base_url} did not answer within {self.timeout_s:g} s", attempts=attempts
                 )
             except openai.APIConnectionError as e:
@@ -191,7 +203,9 @@ class OpenAIBackend:
                         f"{self.base_url} answered {e.status_code}: {e}", status_code=e.status_code, attempts=attempts
                     ) from None
                 kind = LLMRateLimited if e.status_code == 429 else LLMServerError
-                error = kind(f"{self.base_url} answered {e.status_code}: {e}", status_code=e.status_code, attempts=attempts)
+                error = kind(
+                    f"{self.base_url} answered {e.status_code}: {e}", status_code=e.status_code, attempts=attempts
+                )
                 retry_after = _retry_after_s(e.response.headers)
             retries += 1
             if retries > self.max_retries:

@@ -68,7 +68,9 @@ def _skill_and_args(answer: Answer, skill_names: Collection[str]) -> tuple[str, 
     if obj is None:
         call = _call_from_text(answer if isinstance(answer, str) else "", skill_names)
         if call is None:
-            raise InvalidAnswer('no JSON object found; answer with {"reasoning": ..., "skill": ..., "arguments": [...]}')
+            raise InvalidAnswer(
+                'no JSON object found; answer with {"reasoning": ..., "skill": ..., "arguments": [...]}'
+            )
         return call[0], call[1], ""
     reasoning = str(obj.get("reasoning", ""))
     skill, args = obj.get("skill"), obj.get("arguments", [])
@@ -192,5 +194,7 @@ def parse_room_label(answer: Answer, labels: Collection[str] | None = None) -> s
         return _norm(raw).replace(" ", "_")
     label = resolve_name(raw, labels)
     if label is None:
-        raise InvalidAnswer(f"unknown room type {raw.strip()!r}{_closest_hint(raw, labels)}; choose one of: {', '.join(labels)}")
+        raise InvalidAnswer(
+            f"unknown room type {raw.strip()!r}{_closest_hint(raw, labels)}; choose one of: {', '.join(labels)}"
+        )
     return label

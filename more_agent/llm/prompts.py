@@ -49,7 +49,11 @@ def render_prompt(name: str, **fields: str) -> list[ChatMessage]:
         raise ValueError(f"prompt {name!r} needs fields {sorted(missing)}")
     if extra := fields.keys() - needed:
         raise ValueError(f"prompt {name!r} has no fields {sorted(extra)}")
-    return [ChatMessage(role=role, content=t.substitute(fields)) for role, t in load_template(name)]  # type: ignore[typeddict-item]
+    sections = load_template(name)
+    return [
+        ChatMessage(role=role, content=t.substitute(fields))  # type: ignore[typeddict-item]
+        for role, t in sections
+    ]
 
 
 class HistoryItem(Protocol):

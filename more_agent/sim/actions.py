@@ -38,6 +38,9 @@ RING_OFFSETS_M = (0.35, 0.6, 0.9)
 POSES_PER_RING = 32
 """Candidate base poses sampled per circle or ring."""
 
+FLOOR_POSE_SPACING_M = 0.5
+"""Spacing of the candidate positions inside a room when navigating to its floor."""
+
 FORWARD_STEP_M = 0.075
 """Length of one low-level forward move (paper S.3)."""
 
@@ -139,9 +142,15 @@ def _ring(x0: float, y0: float, x1: float, y1: float, offset: float) -> list[XY]
 
 
 def candidate_poses(world: World, name: str) -> list[list[XY]]:
-    """Base positions to try around an object, in rounds: the paper's circle first, then rings around its support."""
+    """Base positions to try around an object, in rounds: the paper's circle first, then rings around its support.
+
+    For a floor (going to a room) the positions are a grid over the room instead.
+    """
     obj = world.get(name)
     x0, y0, x1, y1 = _footprint(obj)
+    if obj.kind == "floor":
+        xs, ys = np.arange(x0 + 0.25, x1, FLOOR_POSE_SPACING_M), np.arange(y0 + 0.25, y1, FLOOR_POSE_SPACING_M)
+        return [[(float(x), float(y)) for y in ys for x in xs]]
     radius = math.hypot(x1 - x0, y1 - y0) / 2 + CLEARANCE_M
     angles = np.linspace(0, 2 * np.pi, POSES_PER_RING, endpoint=False)
     cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
@@ -174,6 +183,15 @@ def count_low_level_steps(yaw: float, waypoints: list[XY], final_yaw: float) -> 
     return steps + _turns(final_yaw - yaw)
 
 
+def approach_rounds(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> list[list[XY]]:
+    """Free base positions within reach of ``name``, in rounds (circle first, then support rings)."""
+    grid = nav_grid(world, config)
+    box = _footprint(world.get(name))
+    rounds = [[p for p in poses if _point_to_box(p, box) <= REACH_M and grid.is_free(*p)]
+              for poses in candidate_poses(world, name)]
+    return [r for r in rounds if r]
+
+
 def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:
     """Drive to the nearest free pose within reach of ``name`` and face it.
 
@@ -190,18 +208,16 @@ def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> Act
     start = (world.robot.x, world.robot.y)
     x0, y0, x1, y1 = _footprint(obj)
     center = ((x0 + x1) / 2, (y0 + y1) / 2)
-    any_candidates: list[XY] = []
-    for poses in candidate_poses(world, name):
-        near = [p for p in poses if _point_to_box(p, (x0, y0, x1, y1)) <= REACH_M]
-        any_candidates += near
-        path = shortest_path(grid, start, near)
+    rounds = approach_rounds(world, name, config)
+    for poses in rounds:
+        path = shortest_path(grid, start, poses)
         if path.found:
             goal = path.waypoints[-1]
-            final_yaw = _heading(goal, center)
+            final_yaw = _heading(goal, center) if math.dist(goal, center) > 1e-6 else world.robot.yaw
             steps = count_low_level_steps(world.robot.yaw, path.waypoints, final_yaw)
             world.set_robot_pose(goal[0], goal[1], final_yaw)
             return _ok(f"reached {_label(obj)}", steps=steps, path=path.waypoints)
-    door = blocking_door(world, start, any_candidates, config)
+    door = blocking_door(world, start, [p for poses in rounds for p in poses], config)
     if door is not None:
         return _fail(
             FailureReason.PATH_BLOCKED_BY_DOOR, f"the way to {_label(obj)} is blocked by closed {_label(world.get(door))}",

@@ -48,9 +48,15 @@ def build_task_data(names: list[str] | None = None, progress: bool = False) -> d
         }
         if scenes:
             try:
-                inst = instantiate_in_scene(d, get_scene(scenes[0], 0), 0)
-                entry["instantiable"] = True
-                entry["unsupported_init"] = inst.unsupported_literals
+                scene = get_scene(scenes[0], 0)
+            except RuntimeError as e:  # the floor-plan generator gave up on this scene
+                entry["reason"] = f"scene {scenes[0]} could not be generated: {e}"
+                scene = None
+            try:
+                if scene is not None:
+                    inst = instantiate_in_scene(d, scene, 0)
+                    entry["instantiable"] = True
+                    entry["unsupported_init"] = inst.unsupported_literals
             except UserError as e:
                 entry["reason"] = str(e)
         tasks[name] = entry

@@ -142,7 +142,7 @@ def _round(v: tuple[float, ...], nd: int = 3) -> tuple[float, ...]:
     return tuple(round(float(x), nd) for x in v)
 
 
-def _room_items(objs: dict[str, int]) -> list[_Item]:
+def _room_items(objs: dict[str, int], wall_top_m: float = 2.5) -> list[_Item]:
     """The room's kept objects, one per instance, largest footprint first."""
     out: list[_Item] = []
     kept: dict[str, int] = {}
@@ -154,6 +154,8 @@ def _room_items(objs: dict[str, int]) -> list[_Item]:
         size = catalog.model_size(model) or catalog.category_size(category)
         if category == "countertop":
             size = (size[0], size[1], catalog.COUNTER_HEIGHT_M)
+        if role == "wall" and catalog.WALL_MOUNTED_CATEGORIES[category] + size[2] > wall_top_m:
+            role = "floor"  # too tall to hang: a floor-standing unit
         cap = catalog.ROLE_CAPS.get(category, catalog.MAX_PER_CATEGORY)
         n = min(count, cap - kept.get(category, 0))
         kept[category] = kept.get(category, 0) + max(n, 0)
@@ -165,8 +167,10 @@ def _room_area(room_id: str, items: list[_Item], rng: np.random.Generator, clear
     lo, hi = TYPICAL_AREA_M2.get(_room_type(room_id), (10.0, 20.0))
     floor = [it for it in items if it.role in ("floor", "free")]
     footprint = sum(it.size[0] * it.size[1] for it in floor)
-    moat = sum((it.size[0] + k["walk"]) * (it.size[1] + k["walk"]) for it in floor)
-    need = max(clearance * footprint, 1.3 * moat) + 4.0
+    # random sequential packing fills about half the plane with walkway-inflated free pieces
+    free = sum((it.size[0] + k["walk"]) * (it.size[1] + k["walk"]) for it in floor if it.role == "free")
+    walled = sum(max(it.size[:2]) * (min(it.size[:2]) + k["walk"]) for it in floor if it.role == "floor")
+    need = max(clearance * footprint, 2.0 * free + 1.3 * walled) + 4.0
     if _room_type(room_id) in OUTDOOR_TYPES and any(it.category in VEHICLES for it in items):
         need += 30.0
     return max(float(rng.uniform(lo, hi)), need)
@@ -292,7 +296,8 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k) -> list[Door] | 
         if key not in tree and (outdoor or rng.random() >= extra_p):
             continue
         run = best[key]
-        c = float(rng.uniform(run.lo + _END_MARGIN_M + k["door_w"] / 2, run.hi - _END_MARGIN_M - k["door_w"] / 2))
+        slack = max(run.hi - run.lo - 2 * _END_MARGIN_M - k["door_w"], 0.0)
+        c = run.lo + _END_MARGIN_M + k["door_w"] / 2 + float(rng.random()) * slack
         center = (c, run.coord) if run.axis == "x" else (run.coord, c)
         doors.append(Door(id=f"door_{len(doors)}", rooms=(run.neg, run.pos), center=_round(center),
                           width=k["door_w"], axis=run.axis, thickness=k["t"], height=DOOR_HEIGHT_M,
@@ -393,7 +398,6 @@ def _furnish_all(rects, items, doors, windows, rng, k) -> tuple[list[Furniture],
             patches.append(GroundPatch(room=rid, bounds=_round(driveway), ground="driveway"))
         placed = furnish_room(rect, items[rid], keep, rng, driveway=driveway, k=k)
         if placed is None:
-            import sys; print("FAIL", rid, rect, len(items[rid]), file=sys.stderr)
             raise _Retry
         for it, center, size in placed:
             if it.role == "carpet":

@@ -23,6 +23,7 @@ _TRIES = 40
 _MOUNT_LEVELS = 3
 _LEVEL_STEP_M = 0.45
 _MAX_MOUNT_TOP_M = 2.5
+_EDGE_INSET_M = 0.05
 
 
 class _Obstacles:
@@ -123,7 +124,7 @@ def _place_floor(inner, it, obstacles: _Obstacles, rng, walk, region):
     long_, short = max(sx, sy), min(sx, sy)
     x0, y0, x1, y1 = inner
     for n in range(_TRIES):
-        against_wall = (it.role == "floor") == (n < 3 * _TRIES // 4)
+        against_wall = (it.role != "free") == (n < 3 * _TRIES // 4)
         if region is None and against_wall:
             side = _SIDES[int(rng.integers(4))]
             lo_a, hi_a = (x0, x1) if side in "SN" else (y0, y1)
@@ -168,6 +169,12 @@ def _place_on_support(it, supports, tops: dict[int, _Obstacles], rng):
             continue
         px = cx - wx / 2 + float(rng.random()) * (wx - w)
         py = cy - wy / 2 + float(rng.random()) * (wy - h)
+        edge = int(rng.integers(4))  # near one edge of the top, within the robot's reach
+        inset = min(_EDGE_INSET_M, (wx - w) / 2 if edge < 2 else (wy - h) / 2)
+        if edge < 2:
+            px = cx - wx / 2 + inset if edge == 0 else cx + wx / 2 - inset - w
+        else:
+            py = cy - wy / 2 + inset if edge == 2 else cy + wy / 2 - inset - h
         r = (px, py, px + w, py + h)
         top = tops.setdefault(idx, _Obstacles())
         if top.clear(r, "", 0.02):

@@ -34,7 +34,7 @@ from more_agent.errors import UserError
 from more_agent.sim import catalog
 from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
 from more_agent.sim.scene import Scene
-from more_agent.sim.tasks import TaskDefinition, describe_goal, load_task, scope_synset, suitable_scenes
+from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal, load_task, scope_synset, suitable_scenes
 from more_agent.sim.world import World, WorldObject
 
 PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
@@ -50,6 +50,9 @@ DOOR_KEEPOUT_M = 0.6
 """Floor items stay this far from door openings so doors stay passable."""
 
 SAMPLE_TRIES = 400
+
+GROUND_CATEGORIES = {"floor": "floors", "driveway": "driveway", "lawn": "lawn", "carpet": "carpet"}
+"""World ground class -> BEHAVIOR category; scopes of these bind to a room's floor object."""
 
 ParsedLiteral = list
 
@@ -143,8 +146,15 @@ def task_description(instance: TaskInstance) -> str:
     """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal."""
     text = instance.definition.paper_description
     if text is not None:
-        return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: instance.label(m.group(1)), text)
+        return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: _scope_phrase(instance, m.group(1)), text)
     return describe_goal(instance.definition.goal, instance.label)
+
+
+def _scope_phrase(instance: TaskInstance, scope: str) -> str:
+    """A scope's label; a scope the paper names but bddl 3.6 lacks reads as 'the <category>'."""
+    if scope in instance.scope:
+        return instance.label(scope)
+    return f"the {category_phrase(scope_synset(scope))}"
 
 
 def literal_text(literal: ParsedLiteral) -> str:
@@ -162,6 +172,7 @@ class _Builder:
         self.unsupported: list[str] = []
         self.items: list[str] = []
         self.agent_floor: str | None = None
+        self.areas: dict[str, tuple[float, float, float, float]] = {}
         future = {lit[1] for lit in definition.init if lit[0] == "future"}
         tax = catalog.taxonomy()
         for synset, scopes in definition.objects.items():
@@ -184,14 +195,18 @@ class _Builder:
                 raise InstantiationError(
                     f"scene {self.world.scene.name} has no {room_type}", literal_text(["inroom", scopes[0], room_type])
                 )
-            best: dict[str, str] = {}
-            for room in rooms:
-                match = self._match_room(room.id, scopes)
-                if len(match) == len(scopes):
-                    best = match
+            ground = [s for s in scopes if _ground_class(scope_synset(s))]
+            fixed = [s for s in scopes if s not in ground]
+            best_room, best = rooms[0].id, self._match_room(rooms[0].id, fixed)
+            for room in rooms[1:]:
+                if len(best) == len(fixed):
                     break
-                if len(match) >= len(best):
-                    best = match
+                match = self._match_room(room.id, fixed)
+                if len(match) > len(best):
+                    best_room, best = room.id, match
+            best |= {s: f"floor_{best_room}" for s in ground}
+            for s in ground:
+                self._bind_ground_patch(s, best_room)
             missing = [s for s in scopes if s not in best]
             if missing:
                 raise InstantiationError(
@@ -201,16 +216,23 @@ class _Builder:
                 )
             self.scope.update(best)
 
+    def _bind_ground_patch(self, scope: str, room_id: str) -> None:
+        """Items put on a driveway / carpet scope go on the room's patch of that ground, if it has one."""
+        ground = _ground_class(scope_synset(scope))
+        patches = [p.bounds for p in getattr(self.world.scene, "ground_patches", []) if p.room == room_id and p.ground == ground]
+        if patches:
+            self.areas[scope] = patches[0]
+
     def _match_room(self, room_id: str, scopes: list[str]) -> dict[str, str]:
-        """Largest one-to-one assignment of scopes to this room's floor / furniture of matching category."""
+        """Largest one-to-one assignment of scopes to this room's furniture / doors of matching category."""
         graph = nx.Graph()
         graph.add_nodes_from(("s", s) for s in scopes)
+        door_rooms = {d.id: d.rooms for d in self.world.scene.doors}
         for s in scopes:
             cats = set(catalog.synset_categories(scope_synset(s)))
             for obj in self.world.objects.values():
-                if obj.room != room_id or obj.kind not in ("floor", "furniture"):
-                    continue
-                if (obj.kind == "floor" and scope_synset(s) == "floor.n.01") or (obj.kind == "furniture" and obj.category in cats):
+                in_room = obj.room == room_id or room_id in door_rooms.get(obj.name, ())
+                if in_room and obj.kind in ("furniture", "door") and obj.category in cats:
                     graph.add_edge(("s", s), ("o", obj.name))
         matching = nx.bipartite.maximum_matching(graph, top_nodes=[("s", s) for s in scopes])
         return {s: matching[("s", s)][1] for s in scopes if ("s", s) in matching}
@@ -284,7 +306,7 @@ class _Builder:
         pred, a, b = atom[0], self.scope[atom[1]], self.scope[atom[2]]
         support = self.world.objects[b]
         if pred in ("ontop", "inside") and support.kind == "floor":
-            self._on_free_floor(a, b)
+            self._on_free_floor(a, b, area=self.areas.get(atom[2]))
         elif pred in ("ontop", "inside"):
             self.world.place(a, b, pred)
             if pred == "inside" and support.openable and atom[2] not in opened:
@@ -300,9 +322,11 @@ class _Builder:
     def _default_floor(self) -> str:
         return self.agent_floor or f"floor_{self.world.scene.rooms[0].id}"
 
-    def _on_free_floor(self, name: str, floor: str, near: WorldObject | None = None) -> None:
+    def _on_free_floor(self, name: str, floor: str, near: WorldObject | None = None,
+                       area: tuple[float, float, float, float] | None = None) -> None:
         obj, room = self.world.objects[name], self.world.objects[floor].room
-        xy = free_floor_spot(self.world, room, obj.size[:2] / 2 + FLOOR_MARGIN_M, self.rng, near=near, exclude=name)
+        half = obj.size[:2] / 2 + FLOOR_MARGIN_M
+        xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area)
         if xy is None:
             where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
             raise InstantiationError(f"no free spot for {name} {where}")
@@ -316,6 +340,12 @@ class _Builder:
         if xy is None:
             raise InstantiationError(f"no free spot for the robot in {room}")
         self.world.set_robot_pose(xy[0], xy[1], float(self.rng.uniform(-np.pi, np.pi)))
+
+
+def _ground_class(synset: str) -> str | None:
+    """The world ground class a synset stands for ('floor.n.01' -> 'floor', 'driveway.n.01' -> 'driveway'), if any."""
+    cats = set(catalog.synset_categories(synset))
+    return next((g for g, c in GROUND_CATEGORIES.items() if c in cats), None)
 
 
 def _item_name(scope: str, taken: set[str]) -> str:
@@ -345,12 +375,12 @@ def _readable(world: World, name: str) -> str:
 
 def free_floor_spot(
     world: World, room_id: str | None, half: np.ndarray, rng: np.random.Generator,
-    near: WorldObject | None = None, exclude: str | None = None,
+    near: WorldObject | None = None, exclude: str | None = None, bounds: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float] | None:
-    """A random (x, y) in a room where a box of half extents ``half`` overlaps no furniture, wall,
-    door opening or floor item; with ``near``, within ``NEXTTO``-like reach of that object's box."""
+    """A random (x, y) in a room (or in ``bounds``) where a box of half extents ``half`` overlaps no
+    furniture, wall, door opening or floor item; with ``near``, close beside that object's box."""
     room = world.scene.room(room_id) if room_id else world.scene.rooms[0]
-    x0, y0, x1, y1 = room.bounds
+    x0, y0, x1, y1 = bounds or room.bounds
     lo, hi = np.array([x0, y0]) + half, np.array([x1, y1]) - half
     if np.any(lo >= hi):
         return None

@@ -23,6 +23,10 @@ from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
 from more_agent.sim.world import World
 
 
+_TOLERANCE = 1e-6
+"""Requests this close to the maximum (float32 actions) count as the maximum, not as clipped."""
+
+
 class MotionFailure(str, Enum):
     """Why a low-level move failed."""
 
@@ -71,7 +75,7 @@ def move_forward(world: World, distance: float = FORWARD_STEP_M, config: NavConf
     if not math.isfinite(distance) or distance < 0:
         return MotionResult(False, MotionFailure.INVALID_AMOUNT, f"cannot move forward by {distance} m", 0.0)
     step = min(distance, FORWARD_STEP_M)
-    note = f" (clipped from {distance:.3f} m)" if step < distance else ""
+    note = f" (clipped from {distance:.3f} m)" if distance > FORWARD_STEP_M + _TOLERANCE else ""
     r = world.robot
     x, y = r.x + step * math.cos(r.yaw), r.y + step * math.sin(r.yaw)
     x0, y0, x1, y1 = world.scene.bounds
@@ -89,7 +93,7 @@ def turn(world: World, angle: float) -> MotionResult:
     if not math.isfinite(angle):
         return MotionResult(False, MotionFailure.INVALID_AMOUNT, f"cannot turn by {angle} rad", 0.0)
     applied = max(-MAX_TURN_RAD, min(MAX_TURN_RAD, angle))
-    note = f" (clipped from {math.degrees(angle):.1f} deg)" if applied != angle else ""
+    note = f" (clipped from {math.degrees(angle):.1f} deg)" if abs(angle) > MAX_TURN_RAD + _TOLERANCE else ""
     r = world.robot
     world.set_robot_pose(r.x, r.y, r.yaw + applied)
     side = "left" if applied >= 0 else "right"

@@ -112,3 +112,10 @@ def test_cli_eval_then_report(tmp_path: Path) -> None:
     assert (tmp_path / "cmp" / "report.html").is_file()
     missing = runner.invoke(app, ["report", str(tmp_path / "nothing")])
     assert missing.exit_code == 2
+
+
+def test_cli_eval_refuses_unknown_task_names_for_the_real_episode(tmp_path: Path) -> None:
+    args = ["eval", "--tasks", "putting_away_halloween_decoratoins", "--planner", "oracle", "--out", str(tmp_path / "r")]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2 and "putting_away_Halloween_decorations" in result.output
+    assert not (tmp_path / "r").exists()

@@ -2,7 +2,8 @@
 
 Each POST to ``/v1/chat/completions`` takes the next script item: a :class:`Reply` (text answer with
 usage), a :class:`Status` (HTTP error, optional ``retry-after``), a :class:`Delay` (wait, then serve
-another item; makes clients time out) or :class:`Close` (drop the connection without answering).
+another item; makes clients time out), :class:`Raw` (any body) or :class:`Close` (drop the connection
+without answering).
 A plain string in a script is a Reply. Requests are recorded in ``server.requests``. Binds to
 127.0.0.1 on a free port; use it as a context manager::
 
@@ -51,11 +52,20 @@ class Delay:
 
 
 @dataclass(frozen=True)
+class Raw:
+    """Any body with any status, e.g. a proxy's HTML error page with status 200."""
+
+    body: bytes
+    status: int = 200
+    content_type: str = "text/html"
+
+
+@dataclass(frozen=True)
 class Close:
     """Drop the connection without sending a response."""
 
 
-ScriptItem = Reply | Status | Delay | Close
+ScriptItem = Reply | Status | Delay | Raw | Close
 
 
 @dataclass(frozen=True)
@@ -139,10 +149,12 @@ class _Handler(BaseHTTPRequestHandler):
         """Silence the default stderr log."""
 
     def _send_json(self, code: int, body: dict[str, Any], headers: dict[str, str] | None = None) -> None:
-        data = json.dumps(body).encode()
+        self._send(code, json.dumps(body).encode(), "application/json", headers)
+
+    def _send(self, code: int, data: bytes, content_type: str, headers: dict[str, str] | None = None) -> None:
         try:
             self.send_response(code)
-            self.send_header("Content-Type", "application/json")
+            self.send_header("Content-Type", content_type)
             self.send_header("Content-Length", str(len(data)))
             for k, v in (headers or {}).items():
                 self.send_header(k, v)
@@ -155,6 +167,8 @@ class _Handler(BaseHTTPRequestHandler):
         if isinstance(item, Delay):
             self.fake._stopped.wait(item.seconds)
             self._serve(item.then, body)
+        elif isinstance(item, Raw):
+            self._send(item.status, item.body, item.content_type)
         elif isinstance(item, Close):
             self.close_connection = True
         elif isinstance(item, Status):

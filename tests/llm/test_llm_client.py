@@ -20,7 +20,7 @@ from more_agent.llm import (
     Unparseable,
     make_client,
 )
-from tests.fakes.openai_server import Close, Delay, FakeOpenAIServer, Reply, Status
+from tests.fakes.openai_server import Close, Delay, FakeOpenAIServer, Raw, Reply, Status
 
 MESSAGES = [ChatMessage(role="system", content="label rooms"), ChatMessage(role="user", content="fridge, oven, sink")]
 
@@ -104,6 +104,15 @@ def test_server_errors_are_retried(fake_openai: FakeOpenAIServer, llm_config: LL
     with pytest.raises(LLMServerError) as info:
         make_client("openai:gpt-4o", llm_config.model_copy(update={"cache_mode": "off"})).complete(MESSAGES)
     assert info.value.status_code == 502 and len(fake_openai.requests) == 6
+
+
+def test_garbage_body_is_a_server_error_and_retried(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:
+    fake_openai.push(Raw(b"<html>bad gateway</html>"), "ok", *[Raw(b"<html>bad gateway</html>")] * 3)
+    client = make_client("openai:gpt-4o", llm_config.model_copy(update={"cache_mode": "off"}))
+    assert client.complete(MESSAGES).attempts == 2
+    with pytest.raises(LLMServerError, match="not a chat completion") as info:
+        client.complete(MESSAGES)
+    assert info.value.attempts == 3
 
 
 def test_bad_request_and_auth_are_not_retried(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:

@@ -1,0 +1,166 @@
+"""The episode runner: instantiate a task, drive a planner step by step, check the goal, write the record.
+
+``run_episode(spec)`` never raises for a failing episode: the reason goes into ``record.error`` (and
+``record.traceback`` when code raised). Termination follows the paper (Sec. III-D): the planner
+calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
+``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
+``episode.json`` and ``map.png`` (the plan with the robot's path). Timings are seconds per phase:
+instantiate, sense, plan, act (goal checks included), write, total. Everything else in the record
+is a function of (task, scene, seed, planner, llm).
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from more_agent.errors import UserError
+from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
+from more_agent.planners.base import EpisodeContext, make_planner
+from more_agent.sim.navgrid import XY
+
+if TYPE_CHECKING:
+    from more_agent.sim.world import World
+
+MAX_HIGH_LEVEL_STEPS = 50
+"""An episode ends after this many high-level steps (paper Sec. III-D)."""
+
+STEPS_AFTER_GOAL = 5
+"""An episode ends when the planner acts this many steps after all goal conditions hold without calling done."""
+
+EPISODE_FILE = "episode.json"
+MAP_FILE = "map.png"
+
+
+def observed_task_objects(scope: dict[str, str], world_names: Iterable[str]) -> list[str]:
+    """Scope names (e.g. 'apple.n.01_1') of the task objects among the observed world objects, sorted."""
+    seen = set(world_names)
+    return sorted(s for s, name in scope.items() if name in seen)
+
+
+class _Clock:
+    """Sums wall time per phase."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+        self._start = time.perf_counter()
+
+    def add(self, phase: str, since: float) -> float:
+        now = time.perf_counter()
+        self.seconds[phase] = self.seconds.get(phase, 0.0) + now - since
+        return now
+
+    def total(self) -> dict[str, float]:
+        out = {k: round(v, 6) for k, v in self.seconds.items()}
+        out["total"] = round(time.perf_counter() - self._start, 6)
+        return out
+
+
+def _extend_path(trajectory: list[XY], path: list[XY]) -> None:
+    for p in path:
+        if not trajectory or trajectory[-1] != p:
+            trajectory.append((round(p[0], 4), round(p[1], 4)))
+
+
+def run_episode(
+    spec: EpisodeSpec,
+    *,
+    out_dir: Path | None = None,
+    save_frames: bool = False,
+    save_graph: bool = False,
+    strict: bool = False,
+) -> EpisodeRecord:
+    """Run one episode of ``spec`` and return its record (also written under ``out_dir`` when given).
+
+    ``strict`` re-raises a ``UserError`` from bad input (unknown task / scene / planner, a task
+    that cannot be instantiated in the scene) instead of recording it: the CLI turns those into
+    exit status 2.
+    """
+    from more_agent.sim.goals import GoalChecker
+    from more_agent.sim.instantiate import instantiate
+
+    clock = _Clock()
+    record = EpisodeRecord(task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm)
+    world: World | None = None
+    try:
+        t = time.perf_counter()
+        instance = instantiate(spec.task, spec.scene, spec.seed)
+        goals = GoalChecker(instance)
+        planner = make_planner(spec.planner, spec.llm)
+        world = instance.world
+        record.scene, record.description = instance.scene, instance.description
+        record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
+        t = clock.add("instantiate", t)
+        planner.reset(EpisodeContext(
+            instance=instance, goals=goals, llm=spec.llm, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph,
+        ))
+        t = clock.add("plan", t)
+        status = goals.check(world)
+        steps_since_goal = 0
+        while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
+            t = time.perf_counter()
+            planner.observe()
+            t = clock.add("sense", t)
+            action = planner.decide()
+            t = clock.add("plan", t)
+            result = planner.execute(action)
+            step = record.high_level_steps
+            record.high_level_steps += 1
+            record.low_level_steps += result.low_level_steps
+            record.actions.append(ActionRecord(
+                step=step, name=action.name, arguments=list(action.arguments), ok=result.ok,
+                feedback=result.feedback, low_level_steps=result.low_level_steps,
+            ))
+            _extend_path(record.trajectory, result.path)
+            if action.is_done:
+                record.done_called = True
+                status = goals.check(world)
+                if not status.all_met and action.note:
+                    record.error = action.note
+                clock.add("act", t)
+                break
+            status = goals.check(world)
+            clock.add("act", t)
+            steps_since_goal = steps_since_goal + 1 if status.all_met else 0
+            if steps_since_goal > STEPS_AFTER_GOAL:
+                record.error = f"all goal conditions held for {STEPS_AFTER_GOAL} steps without done()"
+                break
+        else:
+            record.error = f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
+        record.all_goals_met = status.all_met
+        record.success = status.all_met and record.done_called
+        record.task_progress = status.progress
+        record.goal_conditions = list(status.conditions)
+        record.observed_objects = observed_task_objects(instance.scope, planner.observed_objects())
+        record.llm_usage = planner.llm_usage()
+    except UserError as e:
+        if strict:
+            raise
+        record.error = str(e)
+    except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
+        record.error = f"{type(e).__name__}: {e}"
+        record.traceback = traceback.format_exc()
+    if out_dir is not None:
+        t = time.perf_counter()
+        _write(record, world, Path(out_dir))
+        clock.add("write", t)
+    record.timings = clock.total()
+    if out_dir is not None:
+        (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    return record
+
+
+def _write(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
+    """The map picture (when the world was built); the record itself is written last, with final timings."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if world is None:
+        return
+    from more_agent.viz.trajectory import save_trajectory_map
+
+    try:
+        save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE, title=f"{record.task} ({record.scene})")
+    except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record
+        record.error = record.error or f"could not draw {MAP_FILE}: {type(e).__name__}: {e}"

@@ -1,0 +1,23 @@
+"""Planners: the protocol and registry (``base``), the privileged oracle, and (later) the LLM planners."""
+
+from more_agent.planners.base import (
+    DONE,
+    EpisodeContext,
+    HighLevelAction,
+    Planner,
+    default_planner,
+    make_planner,
+    planner_names,
+    register_planner,
+)
+
+__all__ = [
+    "DONE",
+    "EpisodeContext",
+    "HighLevelAction",
+    "Planner",
+    "default_planner",
+    "make_planner",
+    "planner_names",
+    "register_planner",
+]

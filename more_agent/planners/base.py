@@ -1,0 +1,125 @@
+"""The planner protocol the episode runner drives, and the registry of planners by name.
+
+One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``HighLevelAction``, or
+``done``) and ``execute(action)`` (act: run it in the world, get an ``ActionResult``). The runner
+times the three phases, counts steps and checks the goal; a planner never ends the episode itself
+except by deciding ``done``. Planners are built by name from the registry: ``make_planner('oracle')``.
+Built-in planners are listed by dotted path so that importing this module stays light; other
+code may add its own with ``register_planner``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
+
+from more_agent.errors import unknown_name_error
+from more_agent.eval.record import LLMUsage
+from more_agent.sim.actions import ActionResult
+
+if TYPE_CHECKING:
+    from more_agent.sim.goals import GoalChecker
+    from more_agent.sim.instantiate import TaskInstance
+
+DONE = "done"
+"""Name of the action that ends an episode."""
+
+DEFAULT_PLANNER = "oracle"
+"""The planner ``more-agent run`` uses when none is given and no LLM is configured."""
+
+
+def default_planner(llm: str | None) -> str:
+    """The planner to use when the user names none; the one place this default is decided."""
+    return DEFAULT_PLANNER
+
+
+@dataclass(frozen=True)
+class HighLevelAction:
+    """One planner decision: a subpolicy / magic action name and its arguments (world object names)."""
+
+    name: str
+    arguments: tuple[str, ...] = ()
+    note: str = ""
+    """Why the planner chose it; on a ``done`` that gives up, the explanation of the failure."""
+
+    @property
+    def is_done(self) -> bool:
+        return self.name == DONE
+
+
+@dataclass(frozen=True)
+class EpisodeContext:
+    """What a planner is given at the start of an episode."""
+
+    instance: TaskInstance
+    """The instantiated task; its ``world`` is the episode's world, changed by ``execute``."""
+    goals: GoalChecker
+    """Privileged goal access: only the oracle may read it (LLM planners get ``instance.description``)."""
+    llm: str | None = None
+    """LLM spec such as 'openai:gpt-4o', for planners that need one."""
+    out_dir: Path | None = None
+    """Episode output folder, for planners that save frames or graphs."""
+    save_frames: bool = False
+    """Whether to write the sensor frames of every step under ``out_dir``."""
+    save_graph: bool = False
+    """Whether to write the scene graph of every step under ``out_dir``."""
+
+
+class Planner(Protocol):
+    """A high-level planner the episode runner drives step by step."""
+
+    name: str
+
+    def reset(self, context: EpisodeContext) -> None:
+        """Start an episode."""
+
+    def observe(self) -> None:
+        """Take in what the robot senses now (the sense phase; may do nothing)."""
+
+    def decide(self) -> HighLevelAction:
+        """The next high-level action (the plan phase)."""
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        """Carry out ``action`` in the world (the act phase); failures are results, not exceptions."""
+
+    def observed_objects(self) -> set[str]:
+        """World object names the robot has observed so far this episode."""
+
+    def llm_usage(self) -> LLMUsage:
+        """LLM traffic of this episode so far."""
+
+
+PlannerFactory = Callable[[str | None], Planner]
+"""Builds a planner from an LLM spec (None when no LLM is configured)."""
+
+_BUILTIN: dict[str, str] = {
+    "oracle": "more_agent.planners.oracle:OraclePlanner",
+}
+"""Built-in planners: name -> 'module:attribute' of a factory, imported on first use."""
+
+_registered: dict[str, PlannerFactory] = {}
+
+
+def register_planner(name: str, factory: PlannerFactory) -> None:
+    """Make ``factory`` available as planner ``name`` (replacing any planner of that name)."""
+    _registered[name] = factory
+
+
+def planner_names() -> list[str]:
+    """Names of all available planners, sorted."""
+    return sorted(set(_BUILTIN) | set(_registered))
+
+
+def make_planner(name: str, llm: str | None = None) -> Planner:
+    """A fresh planner by name; an unknown name raises a UserError listing the available ones."""
+    if name in _registered:
+        return _registered[name](llm)
+    if name not in _BUILTIN:
+        err = unknown_name_error("planner", name, planner_names())
+        raise type(err)(f"{err}; available: {', '.join(planner_names())}")
+    module, attr = _BUILTIN[name].split(":")
+    factory: PlannerFactory = getattr(importlib.import_module(module), attr)
+    return factory(llm)

@@ -1,0 +1,267 @@
+"""The oracle planner: privileged access to the BDDL goal and the full world, acting through the magic actions.
+
+It proves instantiated tasks feasible and is the upper-bound row of results tables. At reset it
+picks the ground goal option it can best achieve (fewest literals it cannot handle, then fewest
+unmet), orders its literals (``order_literals``) and then, MPC-style, re-reads the world before
+every step and issues the next subpolicy for the first unmet literal:
+
+- ``inside(a, b)`` / ``ontop(a, b)``: reveal ``a`` and ``b`` (open what hides them), open ``b`` when
+  placing inside, open a closed door between them, then ``go_to_and_grasp a`` and
+  ``go_to_and_place_{inside,ontop} b``; contents go in before their container moves.
+- ``not inside / not ontop``: grasp ``a`` and put it on the floor where the robot stands.
+- ``open(x)`` / ``not open(x)``: ``go_to_and_open`` / ``go_to_and_close`` (closing comes last).
+- ``ontop(robot, floor)``: ``navigate_to`` that room, at the very end.
+
+A closed door reported on the way is opened (after putting down what the hand holds). Literals
+over other predicates are skipped and named in the final ``done`` note; an action that fails twice
+makes the oracle give up with a ``done`` whose note says what failed and why.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from more_agent.eval.record import LLMUsage
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.sim.actions import ActionResult, FailureReason, approach_rounds, go_to_and, navigate_to
+from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
+from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
+from more_agent.sim.world import World
+
+ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
+"""Goal predicates the oracle knows how to achieve."""
+
+MAX_FAILURES_PER_ACTION = 2
+"""The oracle gives up once the same action has failed this many times."""
+
+
+def literal_holds(world: World, lit: Literal) -> bool:
+    """Whether a supported literal holds in ``world`` (the same semantics as the bddl backend)."""
+    if lit.predicate == "open":
+        obj = world.get(lit.args[0])
+        value = obj.openable and obj.is_open
+    elif lit.predicate == "ontop" and lit.args[0] == ROBOT_NAME:
+        value = world.room_at(world.robot.x, world.robot.y) == world.get(lit.args[1]).room
+    elif lit.predicate == "ontop":
+        value = is_ontop(world, lit.args[0], lit.args[1])
+    else:
+        value = world.is_inside(lit.args[0], lit.args[1])
+    return value != lit.negated
+
+
+def unsupported_reason(world: World, lit: Literal) -> str | None:
+    """Why the oracle cannot achieve ``lit``, or None when it can."""
+    if lit.predicate not in ORACLE_PREDICATES:
+        return f"predicate {lit.predicate!r} is not a rearrangement"
+    missing = [a for a in lit.args if a != ROBOT_NAME and a not in world.objects]
+    if missing:
+        return f"{', '.join(missing)} is not an object of the world"
+    if lit.predicate == "open":
+        return None if world.get(lit.args[0]).openable else f"{lit.args[0]} is not openable"
+    subject, target = lit.args
+    if subject == ROBOT_NAME:
+        ok = lit.predicate == "ontop" and not lit.negated and world.get(target).kind == "floor"
+        return None if ok else "the robot can only be asked to stand in a room"
+    if not world.get(subject).movable:
+        return f"{subject} cannot be moved"
+    return None
+
+
+def _group(lit: Literal) -> int:
+    """Order of literal kinds: open, removals, placements, closing, robot position."""
+    if lit.predicate == "open":
+        return 3 if lit.negated else 0
+    if lit.args[0] == ROBOT_NAME:
+        return 4
+    return 1 if lit.negated else 2
+
+
+def order_literals(literals: list[Literal]) -> list[Literal]:
+    """Literals in execution order: by kind, and placements so that what goes into / onto X comes before X moves."""
+    ordered = sorted(literals, key=_group)
+    placements = [lit for lit in ordered if _group(lit) == 2]
+    done: list[Literal] = []
+    todo = list(placements)
+    while todo:
+        # First literal none of whose subject's contents-to-be are still waiting; cycles fall back to order.
+        pick = next((lit for lit in todo if not any(o.args[1] == lit.args[0] for o in todo if o is not lit)), todo[0])
+        done.append(pick)
+        todo.remove(pick)
+    rest = iter(done)
+    return [next(rest) if _group(lit) == 2 else lit for lit in ordered]
+
+
+def choose_option(goals: GoalChecker, world: World) -> int:
+    """The ground goal option with the fewest literals the oracle cannot achieve, then the fewest unmet."""
+    def cost(i: int) -> tuple[int, int, int]:
+        lits = goals.ground_literals(i)
+        unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
+        unmet = sum(unsupported_reason(world, lit) is None and not literal_holds(world, lit) for lit in lits)
+        return unsupported, unmet, i
+    return min(range(goals.n_options), key=cost)
+
+
+class OraclePlanner:
+    """Solves a task from the goal and full state through ``go_to_and_<verb>`` subpolicies."""
+
+    name = "oracle"
+
+    def __init__(self, llm: str | None = None) -> None:
+        self._llm = llm
+
+    def reset(self, context: EpisodeContext) -> None:
+        """Choose the goal option and order its literals."""
+        self._world = context.instance.world
+        self._goals = context.goals
+        literals = context.goals.ground_literals(choose_option(context.goals, self._world))
+        self._skipped = {lit: why for lit in literals if (why := unsupported_reason(self._world, lit)) is not None}
+        self._literals = [lit for lit in order_literals(literals) if lit not in self._skipped]
+        self._door: str | None = None
+        self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
+        self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
+        self._observed: set[str] = set()
+
+    def observe(self) -> None:
+        """The oracle reads the world directly: nothing to sense."""
+
+    def observed_objects(self) -> set[str]:
+        """Objects the oracle acted on, plus what it revealed by opening containers."""
+        return set(self._observed)
+
+    def llm_usage(self) -> LLMUsage:
+        """The oracle uses no LLM."""
+        return LLMUsage()
+
+    # -- deciding -----------------------------------------------------------------------------
+    def decide(self) -> HighLevelAction:
+        """``done`` when the goal holds (or nothing more can be done), else the next subpolicy."""
+        if self._goals.check(self._world).all_met:
+            return HighLevelAction(DONE, note="all goal conditions hold")
+        pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
+        if not pending:
+            return HighLevelAction(DONE, note=self._explain_unmet())
+        action = self._door_action() or self._next(pending)
+        key = (action.name, action.arguments)
+        if self._failures[key] >= MAX_FAILURES_PER_ACTION:
+            why = self._last_feedback[key]
+            note = f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
+            return HighLevelAction(DONE, note=note)
+        return action
+
+    def _explain_unmet(self) -> str:
+        if self._skipped:
+            return "goal literals the oracle cannot achieve: " + "; ".join(
+                f"{lit.text} ({why})" for lit, why in self._skipped.items()
+            )
+        return "every literal of the chosen goal option holds, yet the goal check fails"
+
+    def _door_action(self) -> HighLevelAction | None:
+        """Open the door reported as blocking, first freeing the hand."""
+        if self._door is None or self._world.get(self._door).is_open:
+            self._door = None
+            return None
+        if self._world.robot.held is not None:
+            return self._put_down()
+        return HighLevelAction("go_to_and_open", (self._door,), note="a closed door blocks the way")
+
+    def _next(self, pending: list[Literal]) -> HighLevelAction:
+        held = self._world.robot.held
+        if held is not None:
+            # Finish what the hand holds when its own placement is ready.
+            for lit in pending:
+                if lit.args[0] == held and not lit.negated and lit.predicate != "open":
+                    if self._blocker(lit.args[1], lit.predicate) is None:
+                        return self._act(f"go_to_and_place_{lit.predicate}", lit.args[1], lit)
+        return self._step_for(pending[0])
+
+    def _step_for(self, lit: Literal) -> HighLevelAction:
+        world, held = self._world, self._world.robot.held
+        if lit.predicate == "open":
+            target = lit.args[0]
+            hider = world.enclosing_closed_container(target)
+            if held is not None:
+                return self._put_down()
+            if hider is not None:
+                return self._act("go_to_and_open", hider.name, lit)
+            return self._act("go_to_and_close" if lit.negated else "go_to_and_open", target, lit)
+        subject, target = lit.args
+        if subject == ROBOT_NAME:
+            return self._act("navigate_to", target, lit)
+        if lit.negated:
+            if held == subject:
+                return self._put_down(avoid=target)
+            return self._put_down() if held is not None else self._fetch(subject, lit)
+        blocker = self._blocker(target, lit.predicate)
+        if held == subject:
+            return self._act(f"go_to_and_place_{lit.predicate}", target, lit) if blocker is None else self._put_down()
+        if held is not None:
+            return self._put_down()
+        if blocker is not None:
+            return self._act("go_to_and_open", blocker, lit)
+        door = self._door_between(subject, target)
+        if door is not None:
+            return self._act("go_to_and_open", door, lit)
+        return self._fetch(subject, lit)
+
+    def _act(self, name: str, arg: str, lit: Literal) -> HighLevelAction:
+        return HighLevelAction(name, (arg,), note=f"for {lit.text}")
+
+    def _fetch(self, subject: str, lit: Literal) -> HighLevelAction:
+        hider = self._world.enclosing_closed_container(subject)
+        if hider is not None:
+            return self._act("go_to_and_open", hider.name, lit)
+        return self._act("go_to_and_grasp", subject, lit)
+
+    def _blocker(self, target: str, predicate: str) -> str | None:
+        """What must be opened before something can be placed in / on ``target``."""
+        hider = self._world.enclosing_closed_container(target)
+        if hider is not None:
+            return hider.name
+        obj = self._world.get(target)
+        if predicate == "inside" and obj.openable and not obj.is_open:
+            return target
+        return None
+
+    def _door_between(self, subject: str, target: str) -> str | None:
+        """A closed door between where ``subject`` is and where ``target`` can be reached from."""
+        start = next((p for poses in approach_rounds(self._world, subject) for p in poses), None)
+        goals = [p for poses in approach_rounds(self._world, target) for p in poses]
+        if start is None or not goals or shortest_path(nav_grid(self._world), start, goals).found:
+            return None
+        return blocking_door(self._world, start, goals)
+
+    def _put_down(self, avoid: str | None = None) -> HighLevelAction:
+        """Free the hand: put the held item on the floor of the room the robot is in (or the nearest other)."""
+        world = self._world
+        room = world.room_at(world.robot.x, world.robot.y)
+        floors = sorted(
+            (o for o in world.objects.values() if o.kind == "floor" and o.name != avoid),
+            key=lambda o: (o.room != room, float(((o.center[:2] - world.robot.xy) ** 2).sum())),
+        )
+        return HighLevelAction("go_to_and_place_ontop", (floors[0].name,), note="free the hand")
+
+    # -- acting -------------------------------------------------------------------------------
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        """Run a subpolicy through the magic actions; remember failures and blocking doors."""
+        world = self._world
+        if action.name == DONE:
+            return ActionResult(ok=True, reason=None, feedback="episode ended")
+        (arg,) = action.arguments
+        if action.name == "navigate_to":
+            result = navigate_to(world, arg)
+        elif action.name.startswith("go_to_and_"):
+            result = go_to_and(world, action.name.removeprefix("go_to_and_"), arg)
+        else:
+            raise ValueError(f"oracle cannot execute {action.name!r}")
+        if result.ok:
+            self._observed.add(arg)
+            if action.name == "go_to_and_open":
+                self._observed.update(o.name for o in world.descendants(arg) if world.is_observable(o.name))
+        else:
+            key = (action.name, action.arguments)
+            self._failures[key] += 1
+            self._last_feedback[key] = result.feedback
+            if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR:
+                self._door = result.blocking
+        return result

@@ -1,0 +1,268 @@
+"""``SceneGraphBuilder``: fuses frames incrementally and builds a ``SceneGraph`` per high-level step.
+
+``integrate`` (every frame) only updates the voxel map and per-instance bookkeeping (attributes,
+viewpoints). ``build`` (once per step) runs the whole graph pipeline: BEV -> Voronoi graph ->
+sparsification -> door cuts -> regions (+ sub-region merging) -> stable region ids -> Eq. 1
+object assignment -> frontiers -> reduction to the robot's navigable component -> relations.
+
+Region ids: each region keeps an anchor point; at the next build a region inherits the id of the
+old anchor(s) whose nearest node (within ``2 * sparsify_threshold_m``) it contains, the smallest
+id when several merge; regions without anchor get the next unused ``region_<k>``, in order of
+their smallest (x, y) node. Anchors of regions that are out of reach are remembered, so a room
+seen through a window keeps its id once a door opens. LLM room labels are set with
+``set_room_labels`` and follow their region id in every later build (``SceneGraph.with_room_labels``
+labels one graph only).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from more_agent.mapping import (
+    MappingConfig,
+    NavGraph,
+    VoxelMap,
+    assign_objects,
+    door_crossing_edges,
+    doorway_mask,
+    fit_door_kernel,
+    frontier_points,
+    line_of_sight,
+    merge_subregions,
+    segment_regions,
+    sparsify,
+    voronoi_graph,
+)
+from more_agent.scene_graph.model import (
+    Box3D,
+    InstanceInfo,
+    NavGraphData,
+    ObjectNode,
+    OccupancyMap,
+    RegionNode,
+    Relation,
+    RobotNode,
+    SceneGraph,
+)
+from more_agent.scene_graph.relations import spatial_relations
+from more_agent.sim.scene import FREE_SPACE_CLASSES
+
+STRUCTURE_CATEGORIES = ("wall", "window", "door")
+"""Classes that block line of sight for object assignment."""
+
+
+class SceneGraphBuilder:
+    """Incremental scene-graph builder over posed depth + semantic + instance frames."""
+
+    def __init__(self, class_names: Sequence[str], config: MappingConfig | None = None) -> None:
+        self.config = config or MappingConfig()
+        cfg = self.config
+        self.class_names = list(class_names)
+        self.voxels = VoxelMap(
+            free_class_ids=[i for i, n in enumerate(self.class_names) if n in FREE_SPACE_CLASSES],
+            resolution_m=cfg.resolution_m, z_min_m=cfg.z_min_m, z_max_m=cfg.z_max_m,
+            bev_max_height_m=cfg.bev_max_height_m, max_range_m=cfg.max_range_m,
+            carve_stride_px=cfg.carve_stride_px, initial_extent_m=cfg.initial_extent_m,
+        )
+        self._structure_ids = np.array([i for i, n in enumerate(self.class_names) if n in STRUCTURE_CATEGORIES])
+        self._instances: dict[int, InstanceInfo] = {}
+        self._viewpoints: dict[int, dict[tuple[int, int], tuple[float, float]]] = {}
+        self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._anchors: dict[str, np.ndarray] = {}
+        self._next_region = 0
+        self._room_labels: dict[str, str] = {}
+        self._step = 0
+
+    # ---------------------------------------------------------------- per frame
+    def integrate(
+        self,
+        depth: np.ndarray,
+        semantic: np.ndarray,
+        instance: np.ndarray,
+        K: np.ndarray,
+        T_world_cam: np.ndarray,
+        instances: Mapping[int, InstanceInfo],
+        robot_xy: Sequence[float],
+    ) -> None:
+        """Fuse one frame and remember, for every instance in view, its attributes and the
+        robot position it was seen from. A newly held instance leaves the voxel map."""
+        for iid, info in instances.items():
+            previous = self._instances.get(iid)
+            if info.held and not (previous is not None and previous.held):
+                self.voxels.clear_instance(iid)
+            self._instances[iid] = info
+        held = [iid for iid, info in self._instances.items() if info.held]
+        self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
+        xy = (float(robot_xy[0]), float(robot_xy[1]))
+        key = (round(xy[0] / self.config.viewpoint_spacing_m), round(xy[1] / self.config.viewpoint_spacing_m))
+        for iid in np.unique(instance[np.isfinite(depth)]).tolist():
+            if iid > 0:
+                self._viewpoints.setdefault(iid, {})[key] = xy
+
+    def set_room_labels(self, labels: Mapping[str, str]) -> None:
+        """Room labels (region id -> label) applied to this and every later build."""
+        self._room_labels.update(labels)
+
+    # ---------------------------------------------------------------- per step
+    def build(self, robot_xy: Sequence[float]) -> SceneGraph:
+        """The scene graph of everything observed so far, reduced to the robot's component."""
+        cfg = self.config
+        res, origin = cfg.resolution_m, tuple(self.voxels.origin_xy)
+        robot = np.asarray(robot_xy[:2], dtype=float)
+        occ = self.voxels.occupancy()
+        blocked = np.isin(self.voxels.top_class, self._structure_ids)
+        graph, _ = sparsify(
+            voronoi_graph(occ, resolution_m=res, origin_xy=origin, inflation_m=cfg.inflation_m,
+                          min_separation_m=cfg.gvd_min_separation_m),
+            threshold_m=cfg.sparsify_threshold_m,
+        )
+        voxels = self.voxels.instance_voxels()
+        for iid, pts in voxels.items():
+            self._boxes[iid] = (pts.min(0) - res / 2, pts.max(0) + res / 2)
+        doors = [fit_door_kernel(voxels[i][:, :2], min_sigma_m=cfg.door_min_sigma_m)
+                 for i in sorted(voxels) if i in self._instances and self._instances[i].category == "door"]
+        cut = door_crossing_edges(graph, doors, threshold_m=cfg.door_cut_threshold_m)
+        labels = segment_regions(graph, cut, doors, doorway_value=cfg.door_mask_value)
+        if cfg.merge_subregions and graph.n_nodes:
+            cells = np.floor((graph.xy - origin) / res).astype(int)
+            doorway = doorway_mask(occ.shape, doors, resolution_m=res, origin_xy=origin, value=cfg.door_mask_value)
+            labels = merge_subregions(labels, cells, occ, doorway)
+        region_ids = self._stable_ids(graph, labels)
+
+        objects = sorted(i for i in voxels if i in self._instances and not self._instances[i].held)
+        centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
+        viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
+        assigned = assign_objects(
+            graph, labels, centres[:, :2], viewpoints, cut=cut, blocked=blocked, resolution_m=res,
+            origin_xy=origin, lam=cfg.assignment_lambda, radius_m=cfg.assignment_radius_m, k=cfg.assignment_k,
+        )
+
+        keep = self._robot_component(graph, robot, blocked, origin)
+        frontier_xy, _ = frontier_points(occ, resolution_m=res, origin_xy=origin, min_length_m=cfg.min_frontier_m)
+        frontier_label = self._attach(graph, labels, frontier_xy, blocked, origin)
+        kept_labels = np.unique(labels[keep & (labels >= 0)])
+        return self._assemble(graph, cut, labels, region_ids, keep, kept_labels, objects, assigned,
+                              frontier_xy, frontier_label, robot, occ, origin)
+
+    # ---------------------------------------------------------------- helpers
+    def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
+        vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
+        return xy if len(vps) == 0 else vps[np.argmin(np.linalg.norm(vps - xy, axis=1))]
+
+    def _nearest_visible(self, graph: NavGraph, nodes: np.ndarray, p: np.ndarray, blocked, origin) -> int:
+        """Index (into graph) of the closest of ``nodes`` seeing p, else the closest; -1 if none."""
+        if nodes.size == 0:
+            return -1
+        order = nodes[np.argsort(np.linalg.norm(graph.xy[nodes] - p, axis=1))[: self.config.assignment_k]]
+        seen = line_of_sight(p, graph.xy[order], blocked, origin_xy=np.asarray(origin),
+                             resolution_m=self.config.resolution_m)
+        return int(order[np.argmax(seen)] if seen.any() else order[0])
+
+    def _robot_component(self, graph: NavGraph, robot: np.ndarray, blocked, origin) -> np.ndarray:
+        """Node mask of the (door-uncut) graph component the robot stands in."""
+        node = self._nearest_visible(graph, np.arange(graph.n_nodes), robot, blocked, origin)
+        if node < 0:
+            return np.zeros(graph.n_nodes, dtype=bool)
+        comp = graph.components()
+        return comp == comp[node]
+
+    def _attach(self, graph: NavGraph, labels: np.ndarray, points: np.ndarray, blocked, origin) -> np.ndarray:
+        """Node index (labelled nodes only, -1 if none) each point belongs to."""
+        labelled = np.flatnonzero(labels >= 0)
+        return np.array([self._nearest_visible(graph, labelled, p, blocked, origin) for p in points], dtype=np.int64)
+
+    def _stable_ids(self, graph: NavGraph, labels: np.ndarray) -> list[str]:
+        """Region id per label, inheriting ids through remembered anchors (see module docstring)."""
+        k = int(labels.max()) + 1 if labels.size else 0
+        if k == 0:
+            return []
+        labelled = np.flatnonzero(labels >= 0)
+        tree = cKDTree(graph.xy[labelled])
+        claims: dict[int, list[str]] = {}
+        for rid, anchor in self._anchors.items():
+            dist, i = tree.query(anchor)
+            if dist <= 2 * self.config.sparsify_threshold_m:
+                claims.setdefault(int(labels[labelled[i]]), []).append(rid)
+        ids: list[str] = []
+        for lab in range(k):
+            members = np.flatnonzero(labels == lab)
+            owned = sorted(claims.get(lab, []), key=lambda r: int(r.split("_")[1]))
+            if owned:
+                rid = owned[0]
+                for retired in owned[1:]:
+                    del self._anchors[retired]
+            else:
+                rid = f"region_{self._next_region}"
+                self._next_region += 1
+                centre = graph.xy[members].mean(0)
+                self._anchors[rid] = graph.xy[members[np.argmin(np.linalg.norm(graph.xy[members] - centre, axis=1))]]
+            ids.append(rid)
+        return ids
+
+    def _assemble(self, graph, cut, labels, region_ids, keep, kept_labels, objects, assigned,
+                  frontier_xy, frontier_node, robot, occ, origin) -> SceneGraph:
+        """Put the reduced graph into the data model."""
+        sub_index = np.cumsum(keep) - 1
+        emask = keep[graph.edges[:, 0]] & keep[graph.edges[:, 1]]
+        node_region = [region_ids[lab] if lab >= 0 else None for lab in labels[keep]]
+        kept = set(kept_labels.tolist())
+
+        obj_nodes: dict[str, ObjectNode] = {}
+        region_objects: dict[int, list[str]] = {lab: [] for lab in kept}
+        for iid, lab in zip(objects, assigned.tolist()):
+            if lab in kept:
+                node = self._object_node(iid, region_ids[lab])
+                obj_nodes[node.id] = node
+                region_objects[lab].append(node.id)
+        held = [iid for iid, info in self._instances.items() if info.held and iid in self._boxes]
+        for iid in held:
+            node = self._object_node(iid, None)
+            obj_nodes[node.id] = node
+
+        regions: dict[str, RegionNode] = {}
+        for lab in sorted(kept):
+            rid = region_ids[lab]
+            members = np.flatnonzero(keep & (labels == lab))
+            fr = [tuple(map(float, p)) for p, n in zip(frontier_xy, frontier_node) if n >= 0 and labels[n] == lab]
+            regions[rid] = RegionNode(
+                id=rid, room_label=self._room_labels.get(rid), centroid=tuple(map(float, graph.xy[members].mean(0))),
+                nav_nodes=sub_index[members].tolist(), object_ids=sorted(region_objects[lab]), frontiers=fr,
+            )
+
+        placed = [o for o in obj_nodes.values() if o.category != "door" and not o.held]
+        boxes_min = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
+        boxes_max = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
+        relations = [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
+                     for a, p, b in spatial_relations(boxes_min, boxes_max, tol_m=self.config.relation_tol_m,
+                                                      inside_fraction=self.config.inside_fraction)]
+
+        robot_node = -1
+        labelled_kept = np.flatnonzero(keep & (labels >= 0))
+        if labelled_kept.size:
+            robot_node = labelled_kept[np.argmin(np.linalg.norm(graph.xy[labelled_kept] - robot, axis=1))]
+        held_id = obj_nodes[self._instances[held[0]].label].id if held else None
+        self._step += 1
+        return SceneGraph(
+            step=self._step - 1,
+            robot=RobotNode(position=(float(robot[0]), float(robot[1])),
+                            region_id=region_ids[labels[robot_node]] if robot_node >= 0 else None,
+                            held_object=held_id),
+            regions=regions, objects=obj_nodes, relations=relations,
+            nav=NavGraphData(node_xy=graph.xy[keep], edges=sub_index[graph.edges[emask]],
+                             weights=graph.weights[emask], door_edges=cut[emask],
+                             node_region=node_region),
+            occupancy=OccupancyMap(grid=occ, origin_xy=(float(origin[0]), float(origin[1])),
+                                   resolution_m=self.config.resolution_m),
+        )
+
+    def _object_node(self, iid: int, region_id: str | None) -> ObjectNode:
+        info = self._instances[iid]
+        lo, hi = self._boxes[iid]
+        return ObjectNode(
+            id=info.label, category=info.category, instance_id=iid, label=info.label, region_id=region_id,
+            position=tuple(map(float, (lo + hi) / 2)), bbox=Box3D(min=tuple(map(float, lo)), max=tuple(map(float, hi))),
+            open=info.open, held=info.held,
+        )

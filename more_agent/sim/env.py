@@ -1,0 +1,289 @@
+"""The Gymnasium environment ``MoreAgent/Behavior-v0``: one BEHAVIOR-1K activity in the embedded world.
+
+Observation (a ``spaces.Dict``): ``rgb`` (256, 256, 3) uint8; ``depth`` (256, 256) float32 z-depth in
+metres with **0 where invalid** (nothing hit or beyond 5 m; Gymnasium spaces cannot hold NaN, and
+``frame_from_observation`` restores the renderer's NaN convention); ``semantic`` / ``instance``
+(256, 256) int32 (ids index ``info["class_names"]`` / ``WorldObject.instance_id``); ``pose`` the 4x4
+T_world_cam; ``intrinsics`` K; ``robot_pose`` (x, y, yaw); ``held`` the held item's instance id (0:
+empty hand).
+
+Action (a ``spaces.Dict``): ``type`` indexes ``ACTION_TYPES``; ``amount`` is metres for
+``move_forward`` (at most 0.075) and radians for the turns (at most 35 degrees; more is clipped and
+reported); ``target`` names an object by world name ('fridge_0') or label ('fridge A') for the magic
+actions. Manipulations first drive next to a target out of reach (the paper's go-to-and-act
+subpolicies). ``make_action`` builds actions with the paper's default amounts. An invalid action or
+unknown object is reported in ``info`` (``action_ok`` False, ``reason``, ``feedback``) and the
+episode goes on.
+
+``reset(seed=..., options={"task": ..., "scene": ..., "instance": TaskInstance, "task_seed": int})``:
+an injected instance is used as is; a task is instantiated (seed ``task_seed``, else drawn from
+``np_random``); a scene alone (default ``DEFAULT_SCENE``) gets no task and a start pose drawn from
+``np_random`` among the free cells of the navigation grid. Every episode starts with a full turn
+in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
+view after it. ``info["path_frames"]`` likewise holds views along a magic navigation's path every
+``path_frame_spacing_m``. ``terminated`` when ``done`` is taken; ``truncated`` after ``max_steps``
+steps. The reward is the change in goal progress (0 without a task).
+"""
+
+from __future__ import annotations
+
+import math
+import string
+from collections.abc import Mapping
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from more_agent.sim import actions, motion
+from more_agent.sim.camera import Camera
+from more_agent.sim.goals import GoalChecker, GoalStatus
+from more_agent.sim.instantiate import TaskInstance, instantiate
+from more_agent.sim.navgrid import nav_grid
+from more_agent.sim.render import Frame, Renderer, instance_table
+from more_agent.sim.scenes import get_scene
+from more_agent.sim.world import World
+
+ENV_ID = "MoreAgent/Behavior-v0"
+
+ACTION_TYPES: tuple[str, ...] = (
+    "move_forward", "turn_left", "turn_right", "navigate_to", "open", "close", "grasp", "place_inside", "place_ontop", "done",
+)
+"""Names of the action types, indexed by the action's ``type``."""
+
+DEFAULT_SCENE = "Rs_int"
+"""Scene used when neither the constructor nor reset options name one (no task)."""
+
+TARGET_CHARSET = string.ascii_letters + string.digits + " _-."
+"""Characters of the ``target`` text space (object names and labels)."""
+
+_INT32_MAX = np.iinfo(np.int32).max
+_COORD_LIMIT_M = 1e4
+
+
+def make_action(kind: str, target: str = "", amount: float | None = None) -> dict[str, Any]:
+    """An action dict for ``kind`` (a name in ACTION_TYPES); the amount defaults to a full step or turn."""
+    if amount is None:
+        amount = actions.FORWARD_STEP_M if kind == "move_forward" else actions.MAX_TURN_RAD if kind.startswith("turn") else 0.0
+    return {"type": ACTION_TYPES.index(kind), "amount": np.array(amount, dtype=np.float32), "target": target}
+
+
+def frame_from_observation(obs: Mapping[str, np.ndarray]) -> Frame:
+    """The renderer's ``Frame`` (NaN for invalid depth) from an observation."""
+    depth = obs["depth"].astype(np.float32, copy=True)
+    depth[depth <= 0] = np.nan
+    return Frame(rgb=obs["rgb"].copy(), depth=depth, semantic=obs["semantic"].copy(), instance=obs["instance"].copy(),
+                 K=obs["intrinsics"].copy(), T_world_cam=obs["pose"].copy())
+
+
+class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
+    """Rearrangement in the embedded BEHAVIOR-1K world with ground-truth RGB-D-semantic perception."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
+
+    def __init__(self, task: str | None = None, scene: str | None = None, *, render_mode: str | None = None,
+                 max_steps: int = 1000, camera: Camera | None = None, path_frame_spacing_m: float = 1.0) -> None:
+        """``task`` / ``scene``: what reset loads when its options name nothing; ``max_steps``: truncation
+        limit in env steps; ``path_frame_spacing_m``: spacing of the views along a navigation path (0: none)."""
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"unsupported render_mode {render_mode!r}; supported: {self.metadata['render_modes']}")
+        self.render_mode = render_mode
+        self.task, self.scene, self.max_steps = task, scene, max_steps
+        self.path_frame_spacing_m = path_frame_spacing_m
+        self.renderer = Renderer(camera)
+        cam = self.renderer.camera
+        hw = (cam.height, cam.width)
+        ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
+        self.observation_space = spaces.Dict({
+            "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
+            "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
+            "semantic": ids,
+            "instance": ids,
+            "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
+            "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
+            "robot_pose": spaces.Box(np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
+                                     np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]), (3,), np.float64),
+            "held": spaces.Box(0, _INT32_MAX, (), np.int32),
+        })
+        self.action_space = spaces.Dict({
+            "type": spaces.Discrete(len(ACTION_TYPES)),
+            "amount": spaces.Box(0.0, np.float32(math.pi), (), np.float32),
+            "target": spaces.Text(max_length=128, min_length=0, charset=TARGET_CHARSET),
+        })
+        self.world: World | None = None
+        self.instance: TaskInstance | None = None
+        self._goal: GoalChecker | None = None
+        self._progress = 0.0
+        self._steps = 0
+        self._low_level_steps = 0
+        self._last_rgb: np.ndarray | None = None
+
+    # -- episode ---------------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        options = options or {}
+        self.instance = self._load(options)
+        if self.instance is not None:
+            self.world = self.instance.world
+            self._goal = GoalChecker(self.instance)
+        else:
+            self.world = World.from_scene(get_scene(options.get("scene") or self.scene or DEFAULT_SCENE, 0))
+            self._goal = None
+            self._spawn()
+        self._steps, self._low_level_steps = 0, 0
+        turn_frames = [self._record()]
+        angles = motion.full_turn_angles()
+        for i, angle in enumerate(angles):
+            motion.turn(self.world, angle)
+            if i < len(angles) - 1:
+                turn_frames.append(self._record())
+        self._low_level_steps = len(angles)
+        status = self._status()
+        self._progress = status.progress if status is not None else 0.0
+        obs = {k: v.copy() for k, v in turn_frames[0]["obs"].items()}  # the turn ends where it began
+        self._last_rgb = obs["rgb"]
+        info = self._info(status, "reset", True, None, "turned around in place", len(angles), [], turn_frames[0]["instances"])
+        info.update(
+            turn_frames=turn_frames, path_frames=[], class_names=list(self.world.class_names),
+            task=self.instance.task if self.instance else None,
+            task_description=self.instance.description if self.instance else None,
+        )
+        return obs, info
+
+    def step(self, action: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], SupportsFloat, bool, bool, dict[str, Any]]:
+        if self.world is None:
+            raise RuntimeError("call reset() before step()")
+        self._steps += 1
+        kind, amount, target, error = _parse(action)
+        path: list[tuple[float, float]] = []
+        if error is not None:
+            ok, reason, feedback, steps = False, "invalid_action", error, 0
+        elif kind == "done":
+            ok, reason, feedback, steps = True, None, "episode ended", 0
+        elif kind in ("move_forward", "turn_left", "turn_right"):
+            res = self._move(kind, amount)
+            ok, reason, feedback, steps = res.ok, res.reason.value if res.reason else None, res.feedback, res.low_level_steps
+        else:
+            name = self._resolve(target)
+            if name is None:
+                ok, reason, feedback, steps = False, "unknown_object", f"unknown object {target!r}", 0
+            else:
+                res = actions.navigate_to(self.world, name) if kind == "navigate_to" else actions.go_to_and(self.world, kind, name)
+                ok, reason, feedback, steps, path = res.ok, res.reason.value if res.reason else None, res.feedback, res.low_level_steps, list(res.path)
+        self._low_level_steps += steps
+        record = self._record()
+        status = self._status()
+        progress = status.progress if status is not None else 0.0
+        reward, self._progress = progress - self._progress, progress
+        self._last_rgb = record["obs"]["rgb"]
+        info = self._info(status, kind or "invalid", ok, reason, feedback, steps, path, record["instances"])
+        info["path_frames"] = self._path_frames(path)
+        truncated = self._steps >= self.max_steps and kind != "done"
+        return record["obs"], float(reward), kind == "done", truncated, info
+
+    def render(self) -> np.ndarray | None:
+        """The RGB frame of the latest observation (``render_mode="rgb_array"``)."""
+        if self.render_mode != "rgb_array" or self._last_rgb is None:
+            return None
+        return self._last_rgb.copy()
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def _load(self, options: Mapping[str, Any]) -> TaskInstance | None:
+        """The task instance the options (or the constructor) ask for, or None for a scene without task."""
+        if options.get("instance") is not None:
+            return options["instance"]
+        task = options.get("task") or (self.task if not options.get("scene") else None)
+        if task is None:
+            return None
+        task_seed = options.get("task_seed")
+        if task_seed is None:
+            task_seed = int(self.np_random.integers(2**31 - 1))
+        return instantiate(task, options.get("scene") or self.scene, seed=int(task_seed))
+
+    def _spawn(self) -> None:
+        """Put the robot at a free navigation cell and heading drawn from ``np_random``."""
+        assert self.world is not None
+        grid = nav_grid(self.world)
+        rows, cols = np.nonzero(grid.free)
+        if len(rows) == 0:
+            raise ValueError(f"scene {self.world.scene.name} has no free space for the robot")
+        k = int(self.np_random.integers(len(rows)))
+        x, y = grid.to_xy(int(rows[k]), int(cols[k]))
+        self.world.set_robot_pose(x, y, float(self.np_random.uniform(-math.pi, math.pi)))
+
+    def _move(self, kind: str, amount: float) -> motion.MotionResult:
+        assert self.world is not None
+        if kind == "move_forward":
+            return motion.move_forward(self.world, amount)
+        if amount < 0:
+            return motion.MotionResult(False, motion.MotionFailure.INVALID_AMOUNT, f"turn amount must be >= 0, got {amount}", 0.0)
+        return motion.turn(self.world, amount if kind == "turn_left" else -amount)
+
+    def _resolve(self, target: str) -> str | None:
+        """World name of the object a target names (its name, or its label, case-insensitively)."""
+        assert self.world is not None
+        key = target.strip()
+        if key in self.world.objects:
+            return key
+        obj = next((o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None)
+        return obj.name if obj is not None else None
+
+    def _status(self) -> GoalStatus | None:
+        return self._goal.check(self.world) if self._goal is not None else None
+
+    def _record(self, pose: tuple[float, float, float] | None = None) -> dict[str, Any]:
+        """{"obs": observation, "instances": instance table} at the robot's pose or at ``pose`` (x, y, yaw)."""
+        assert self.world is not None
+        r = self.world.robot
+        x, y, yaw = pose if pose is not None else (r.x, r.y, r.yaw)
+        frame = self.renderer.render_at(self.world, self.renderer.camera.pose(x, y, yaw))
+        held = self.world.objects[r.held].instance_id if r.held is not None else 0
+        obs = {
+            "rgb": frame.rgb, "depth": np.nan_to_num(frame.depth, nan=0.0), "semantic": frame.semantic,
+            "instance": frame.instance, "pose": frame.T_world_cam, "intrinsics": frame.K,
+            "robot_pose": np.array([x, y, yaw], dtype=np.float64), "held": np.array(held, dtype=np.int32),
+        }
+        return {"obs": obs, "instances": instance_table(self.world, frame.instance)}
+
+    def _path_frames(self, path: list[tuple[float, float]]) -> list[dict[str, Any]]:
+        """Views every ``path_frame_spacing_m`` along a path, facing along it (none when disabled)."""
+        if self.path_frame_spacing_m <= 0 or len(path) < 2:
+            return []
+        out = []
+        for (x0, y0), (x1, y1) in zip(path[:-1], path[1:], strict=True):
+            length = math.hypot(x1 - x0, y1 - y0)
+            heading = math.atan2(y1 - y0, x1 - x0)
+            for s in np.arange(0.0, length, self.path_frame_spacing_m):
+                out.append(self._record((x0 + (x1 - x0) * s / length, y0 + (y1 - y0) * s / length, heading)))
+        return out
+
+    def _info(self, status: GoalStatus | None, kind: str, ok: bool, reason: str | None, feedback: str, steps: int,
+              path: list[tuple[float, float]], instances: dict[int, dict[str, Any]]) -> dict[str, Any]:
+        return {
+            "action": kind, "action_ok": ok, "reason": reason, "feedback": feedback,
+            "low_level_steps": steps, "total_low_level_steps": self._low_level_steps, "steps": self._steps,
+            "path": [tuple(map(float, p)) for p in path], "instances": instances, "goal_status": status,
+        }
+
+
+def _parse(action: Any) -> tuple[str | None, float, str, str | None]:
+    """(type name, amount, target, error): the error says why an action is malformed."""
+    if not isinstance(action, Mapping):
+        return None, 0.0, "", f"action must be a dict with type / amount / target, got {type(action).__name__}"
+    try:
+        index = int(action.get("type"))  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return None, 0.0, "", f"action type must be an integer, got {action.get('type')!r}"
+    if not 0 <= index < len(ACTION_TYPES):
+        return None, 0.0, "", f"action type {index} is not one of 0..{len(ACTION_TYPES) - 1}"
+    kind = ACTION_TYPES[index]
+    default = make_action(kind)["amount"]
+    try:
+        amount = float(np.asarray(action.get("amount", default), dtype=np.float64).reshape(()))
+    except (TypeError, ValueError):
+        return kind, 0.0, "", f"action amount must be a number, got {action.get('amount')!r}"
+    target = action.get("target", "")
+    if not isinstance(target, str):
+        return kind, amount, "", f"action target must be a string, got {type(target).__name__}"
+    return kind, amount, target, None

@@ -1,0 +1,64 @@
+"""One PNG of a scene graph: BEV occupancy, sparse Voronoi graph coloured by region, doors,
+objects, frontiers and the robot."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
+
+from more_agent.scene_graph.model import SceneGraph  # noqa: E402
+
+_OCC_CMAP = ListedColormap(["#d9d9d9", "#ffffff", "#303030"])  # unknown, free, occupied
+
+
+def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None = None, dpi: int = 120) -> Path:
+    """Write the picture to ``path`` (PNG) and return the path. World x is to the right, y up."""
+    path = Path(path)
+    fig, ax = plt.subplots(figsize=(8, 8))
+    occ = graph.occupancy
+    if occ is not None:
+        nx_, ny_ = occ.grid.shape
+        x0, y0 = occ.origin_xy
+        extent = (x0, x0 + nx_ * occ.resolution_m, y0, y0 + ny_ * occ.resolution_m)
+        ax.imshow(occ.grid.T, origin="lower", extent=extent, cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest")
+    colours = plt.get_cmap("tab10")
+    region_colour = {rid: colours(i % 10) for i, rid in enumerate(sorted(graph.regions))}
+    xy = graph.nav.node_xy
+    if len(graph.nav.edges):
+        segs = xy[graph.nav.edges]
+        edge_colour = [
+            "#ff00ff" if door else region_colour.get(graph.nav.node_region[a] or "", "#999999")
+            for (a, _), door in zip(graph.nav.edges, graph.nav.door_edges)
+        ]
+        ax.add_collection(LineCollection(segs, colors=edge_colour, linewidths=1.2))
+    for rid, region in graph.regions.items():
+        pts = xy[region.nav_nodes]
+        name = rid if region.room_label is None else f"{rid} ({region.room_label})"
+        ax.scatter(pts[:, 0], pts[:, 1], s=10, color=region_colour[rid], label=name, zorder=3)
+        if region.frontiers:
+            f = np.array(region.frontiers)
+            ax.scatter(f[:, 0], f[:, 1], marker="*", s=90, color=region_colour[rid], edgecolors="k", zorder=4)
+    for obj in graph.objects.values():
+        lo, hi = obj.bbox.min, obj.bbox.max
+        door = obj.category == "door"
+        ax.add_patch(plt.Rectangle((lo[0], lo[1]), hi[0] - lo[0], hi[1] - lo[1], fill=False,
+                                   edgecolor="#ff00ff" if door else "#1f77b4", linewidth=1.5, zorder=4))
+        ax.annotate(obj.label, (obj.position[0], obj.position[1]), fontsize=7, zorder=5)
+    rx, ry = graph.robot.position
+    ax.scatter([rx], [ry], marker="^", s=120, color="#d62728", edgecolors="k", label="robot", zorder=6)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="upper right", fontsize=7)
+    ax.set_title(title or f"scene graph, step {graph.step}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

@@ -1,0 +1,70 @@
+"""One PNG of a scene's floor plan: ground classes, walls, windows, doors (open / closed), furniture."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
+
+from more_agent.sim.scene import Scene  # noqa: E402
+
+GROUND_COLOURS: dict[str, str] = {"floor": "#efe6d2", "carpet": "#c9a0a0", "lawn": "#9fd38a", "driveway": "#a9a9a9"}
+_WALL, _FENCE, _WINDOW = "#303030", "#7a5c3a", "#4fa3e0"
+_OPEN_DOOR, _CLOSED_DOOR = "#2ca02c", "#d62728"
+_FURNITURE, _OPENABLE = "#8c6d46", "#c7822b"
+
+
+def _rect(b, **kw) -> Rectangle:
+    return Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1], **kw)
+
+
+def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture: bool = False) -> Path:
+    """Draw ``scene`` seen from above into ``path`` (PNG) and return the path. x right, y up."""
+    path = Path(path)
+    w, h = scene.bounds[2] - scene.bounds[0], scene.bounds[3] - scene.bounds[1]
+    scale = 10.0 / max(w, h)
+    fig, ax = plt.subplots(figsize=(max(w * scale, 4) + 2.5, max(h * scale, 4)))
+    for r in scene.rooms:
+        ax.add_patch(_rect(r.bounds, facecolor=GROUND_COLOURS[r.ground], edgecolor="none", zorder=0))
+    for p in scene.ground_patches:
+        ax.add_patch(_rect(p.bounds, facecolor=GROUND_COLOURS[p.ground], edgecolor="none", zorder=1))
+    for wall in scene.walls:
+        if wall.z_min > 0:  # lintels and window tops: the gap below is drawn instead
+            continue
+        colour = _FENCE if wall.z_max < 2.0 else _WALL
+        ax.add_patch(_rect(wall.bounds, facecolor=colour, edgecolor="none", zorder=3))
+    for win in scene.windows:
+        ax.add_patch(_rect(win.bounds, facecolor=_WINDOW, edgecolor="none", zorder=4))
+    for d in scene.doors:
+        b = d.bounds()
+        ax.add_patch(_rect(b, facecolor=_OPEN_DOOR if d.open else _CLOSED_DOOR, edgecolor="none", zorder=4))
+    for f in scene.furniture:
+        b = (f.center[0] - f.size[0] / 2, f.center[1] - f.size[1] / 2, f.center[0] + f.size[0] / 2, f.center[1] + f.size[1] / 2)
+        ax.add_patch(_rect(b, facecolor=_OPENABLE if f.openable else _FURNITURE, edgecolor="black",
+                           linewidth=0.3, alpha=0.85, zorder=2 + f.center[2] / 10))
+        if label_furniture:
+            ax.text(f.center[0], f.center[1], f.id, fontsize=4, ha="center", va="center", zorder=6)
+    for r in scene.rooms:
+        cx, cy = (r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2
+        ax.text(cx, cy, r.id, fontsize=8, ha="center", va="center", zorder=7,
+                bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.7, linewidth=0))
+    legend = [Patch(color=c, label=g) for g, c in GROUND_COLOURS.items()] + [
+        Patch(color=_WALL, label="wall"), Patch(color=_FENCE, label="fence"), Patch(color=_WINDOW, label="window"),
+        Patch(color=_OPEN_DOOR, label="open door"), Patch(color=_CLOSED_DOOR, label="closed door"),
+        Patch(color=_FURNITURE, label="furniture"), Patch(color=_OPENABLE, label="openable furniture"),
+    ]
+    ax.legend(handles=legend, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    ax.set_xlim(scene.bounds[0], scene.bounds[2])
+    ax.set_ylim(scene.bounds[1], scene.bounds[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(f"{scene.name} (seed {scene.seed})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

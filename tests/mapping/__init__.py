@@ -1,0 +1,1 @@
+"""Tests of more_agent.mapping."""

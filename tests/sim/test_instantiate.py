@@ -1,0 +1,117 @@
+"""Task instantiation: every init literal holds or is reported, scopes bound, robot placed, errors explicit."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from bddl.condition_evaluation import compile_state
+
+from more_agent.errors import UserError
+from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
+from more_agent.sim.instantiate import InstantiationError, TaskInstance, instantiate, instantiate_in_scene, literal_text
+from more_agent.sim.scene import load_scene
+from more_agent.sim.tasks import task_set
+
+KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
+
+EXPECTED_PAPER_FAILURES: dict[str, str] = {}
+"""more-paper tasks that do not instantiate in their first suitable scene (seed 0), with why; see docs/tasks.md."""
+
+
+def _check_init(inst: TaskInstance) -> None:
+    """Every init literal is inroom, recorded as unsupported, or true through the backend."""
+    backend = WorldBackend(inst.world)
+    scope = inst.scope_objects()
+    assert all(isinstance(v, ScopeObject) for v in scope.values())
+    assert set(scope) == set(inst.definition.scopes)
+    for lit in inst.definition.init:
+        text = literal_text(lit)
+        if lit[0] == "inroom" or text in inst.unsupported_literals:
+            continue
+        head = compile_state([lit], backend, scope=dict(scope), object_map=inst.definition.objects,
+                             generate_ground_options=False)[0]
+        assert head.evaluate(), f"{inst.task}: {text}"
+
+
+def _check_floor_items_clear(inst: TaskInstance) -> None:
+    """Items resting on a floor overlap no furniture footprint (they can be reached)."""
+    world = inst.world
+    furniture = [o for o in world.objects.values() if o.kind == "furniture"]
+    for item in world.items():
+        if item.parent and world.objects[item.parent].kind == "floor" and not any(
+            lit[0] == "under" and inst.scope.get(lit[1]) == item.name for lit in inst.definition.init
+        ):
+            for f in furniture:
+                gap = np.abs(item.center[:2] - f.center[:2]) - (item.size[:2] + f.size[:2]) / 2
+                assert np.any(gap >= 0), f"{inst.task}: {item.name} overlaps {f.name}"
+
+
+def test_every_paper_task_instantiates_or_fails_explicitly() -> None:
+    failures = {}
+    for task in task_set("more-paper"):
+        try:
+            inst = instantiate(task, seed=0)
+        except InstantiationError as e:
+            failures[task] = str(e)
+            continue
+        _check_init(inst)
+        _check_floor_items_clear(inst)
+        assert inst.world.room_at(inst.world.robot.x, inst.world.robot.y) is not None
+        assert "$" not in inst.description
+    assert set(failures) == set(EXPECTED_PAPER_FAILURES), failures
+
+
+def test_hand_built_scene_binds_labels_and_describes() -> None:
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=3)
+    world = inst.world
+    assert inst.scope["electric_refrigerator.n.01_1"] == "fridge_0"
+    assert inst.scope["floor.n.01_1"] == "floor_kitchen_0"
+    assert inst.scope["agent.n.01_1"] == "robot"
+    assert inst.scope["pack__of__ground_beef.n.01_1"] == "pack__of__ground_beef_1"
+    assert world.get("pack__of__ground_beef_1").label == "pack_of_ground_beef A" or world.get(
+        "pack__of__ground_beef_1").label.endswith(" A")
+    assert world.is_inside("pack__of__ground_beef_1", "sack_1")
+    assert world.get("sack_1").parent == "floor_kitchen_0"
+    cabinet = world.get(inst.scope["cabinet.n.01_1"]).label
+    assert inst.description == f"store dairy and meat in fridge A, and other food and oil in {cabinet}"
+    assert world.room_at(world.robot.x, world.robot.y) == "kitchen_0"
+    assert inst.unsupported_literals == []
+    _check_init(inst)
+
+
+def test_deterministic_per_seed() -> None:
+    scene = load_scene(KITCHEN)
+    a, b = (instantiate_in_scene("putting_shopping_away", scene, seed=5) for _ in range(2))
+    c = instantiate_in_scene("putting_shopping_away", scene, seed=6)
+    pos = lambda i: [tuple(o.center) for o in i.world.items()] + [(i.world.robot.x, i.world.robot.y)]  # noqa: E731
+    assert pos(a) == pos(b)
+    assert pos(a) != pos(c)
+
+
+def test_missing_furniture_names_the_literal() -> None:
+    scene = load_scene(KITCHEN)
+    scene = scene.model_copy(update={"furniture": [f for f in scene.furniture if f.category != "fridge"]})
+    with pytest.raises(InstantiationError, match=r"inroom electric_refrigerator\.n\.01_1 kitchen") as err:
+        instantiate_in_scene("putting_shopping_away", scene)
+    assert isinstance(err.value, UserError)
+    assert err.value.literal == "(inroom electric_refrigerator.n.01_1 kitchen)"
+
+
+def test_non_rearrangement_literals_are_recorded() -> None:
+    inst = instantiate("assembling_gift_baskets", seed=0)
+    inst2 = instantiate("cook_bacon", seed=0)
+    assert inst.unsupported_literals == []
+    assert any(lit.startswith("(") and "cooked" in lit or "insource" in lit or "attached" in lit
+               for lit in inst2.unsupported_literals), inst2.unsupported_literals
+    _check_init(inst2)
+
+
+def test_open_literals_and_closed_containers() -> None:
+    inst = instantiate_in_scene("putting_dishes_away_after_cleaning", load_scene(KITCHEN), seed=0)
+    for lit in inst.definition.init:
+        if lit[0] == "open" or (lit[0] == "not" and lit[1][0] == "open"):
+            name = inst.scope[(lit[1] if lit[0] == "not" else lit)[1]]
+            assert inst.world.get(name).is_open == (lit[0] == "open")
+    _check_init(inst)

@@ -1,0 +1,182 @@
+"""Ray-cast frames: depth, semantic and instance ids, occlusion by walls, doors and containers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from more_agent.sim.camera import Camera, camera_pose, project
+from more_agent.sim.render import Renderer, instance_table, render, scene_geometry
+from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall, Window
+from more_agent.sim.world import World, WorldObject
+
+T = 0.1  # wall thickness
+
+
+def two_rooms() -> World:
+    """Room a (x 0..4, floor) and room b (x 4..8, carpet), a door at (4, 2), a window in a's south wall,
+    a closed fridge in a and a table in b; walls are centred on the room edges."""
+    h = T / 2
+    walls = [
+        Wall(bounds=(-h, -h, h, 4 + h)), Wall(bounds=(8 - h, -h, 8 + h, 4 + h)), Wall(bounds=(-h, 4 - h, 8 + h, 4 + h)),
+        Wall(bounds=(-h, -h, 1.5, h)), Wall(bounds=(2.5, -h, 8 + h, h)),  # south wall, window gap at x 1.5..2.5
+        Wall(bounds=(1.5, -h, 2.5, h), z_max=0.9), Wall(bounds=(1.5, -h, 2.5, h), z_min=2.0),
+        Wall(bounds=(4 - h, -h, 4 + h, 1.5)), Wall(bounds=(4 - h, 2.5, 4 + h, 4 + h)),  # door gap at y 1.5..2.5
+        Wall(bounds=(4 - h, 1.5, 4 + h, 2.5), z_min=2.1),
+    ]
+    scene = Scene(
+        name="two_rooms", bounds=(-h, -h, 8 + h, 4 + h),
+        rooms=[Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4, 4)),
+               Room(id="living_room_0", type="living_room", bounds=(4, 0, 8, 4), ground="carpet")],
+        walls=walls,
+        doors=[Door(id="door_0", rooms=("kitchen_0", "living_room_0"), center=(4, 2), width=1.0, axis="y", thickness=T)],
+        windows=[Window(id="window_0", bounds=(1.5, -h, 2.5, h), rooms=("kitchen_0",))],
+        furniture=[
+            Furniture(id="fridge_0", category="fridge", room="kitchen_0", center=(1, 3.5, 0.9), size=(0.8, 0.7, 1.8), openable=True),
+            Furniture(id="table_0", category="table", room="living_room_0", center=(6, 2, 0.375), size=(1, 1, 0.75)),
+        ],
+    )
+    world = World.from_scene(scene)
+    world.add(WorldObject(name="apple_0", category="apple", kind="item", center=np.zeros(3), size=np.array([0.08, 0.08, 0.08])))
+    world.place("apple_0", "fridge_0", "inside")
+    world.add(WorldObject(name="mug_0", category="mug", kind="item", center=np.zeros(3), size=np.array([0.1, 0.1, 0.12])))
+    world.place("mug_0", "table_0", "ontop")
+    world.assign_labels()
+    return world
+
+
+def back_project(frame, v: int, u: int) -> np.ndarray:
+    """World point seen at pixel (row v, column u)."""
+    p = np.linalg.inv(frame.K) @ np.array([u, v, 1.0]) * frame.depth[v, u]
+    return frame.T_world_cam[:3, :3] @ p + frame.T_world_cam[:3, 3]
+
+
+def pixel_of(frame, point) -> tuple[int, int]:
+    uv, _ = project(np.array([point], dtype=float), frame.K, frame.T_world_cam)
+    u, v = uv[0]
+    return int(round(v)), int(round(u))
+
+
+def test_camera_pose_is_a_pitched_opencv_frame():
+    T = camera_pose(1.0, 2.0, math.pi / 2, height_m=1.2, pitch_rad=math.radians(20))
+    R = T[:3, :3]
+    assert np.allclose(R.T @ R, np.eye(3)) and np.isclose(np.linalg.det(R), 1.0)
+    assert np.allclose(T[:3, 3], [1, 2, 1.2])
+    assert np.allclose(R[:, 2], [0, math.cos(math.radians(20)), -math.sin(math.radians(20))])  # forward: north, down
+    assert np.allclose(R[:, 0], [1, 0, 0])  # right of north is east
+    K = Camera().intrinsics()
+    assert K[0, 0] == pytest.approx(128.0) and K[0, 2] == pytest.approx(127.5)  # 90 deg horizontal FOV
+
+
+def test_depth_to_a_wall_at_a_known_distance():
+    world = two_rooms()
+    world.set_robot_pose(2.0, 2.0, math.pi)  # facing the west wall, whose face is at x = 0.05
+    frame = Renderer(Camera(pitch_deg=0.0)).render(world)
+    assert frame.depth.dtype == np.float32 and frame.depth.shape == (256, 256)
+    wall = world.class_names.index("wall")
+    assert frame.depth[128, 128] == pytest.approx(1.95, abs=1e-4)
+    assert frame.depth[64, 40] == pytest.approx(1.95, abs=1e-4)  # z-depth: same on the whole plane
+    assert frame.semantic[128, 128] == wall and frame.instance[128, 128] == 0
+
+
+def test_back_projected_pixels_land_on_the_surfaces_hit():
+    world = two_rooms()
+    world.set_robot_pose(2.0, 2.0, math.pi)
+    frame = render(world)
+    floor = world.class_names.index("floor")
+    assert frame.semantic[250, 128] == floor
+    assert back_project(frame, 250, 128)[2] == pytest.approx(0.0, abs=1e-4)
+    assert back_project(frame, 60, 128)[0] == pytest.approx(T / 2, abs=1e-4)
+
+
+def test_semantic_and_instance_of_a_known_object():
+    world = two_rooms()
+    world.set_robot_pose(1.0, 1.0, math.pi / 2)  # facing the fridge 2.15 m north
+    frame = render(world)
+    fridge = world.get("fridge_0")
+    v, u = pixel_of(frame, (1.0, 3.15, 0.9))
+    assert frame.semantic[v, u] == world.class_names.index("fridge")
+    assert frame.instance[v, u] == fridge.instance_id
+    assert back_project(frame, v, u)[1] == pytest.approx(3.15, abs=1e-3)
+    table = instance_table(world, frame.instance)
+    assert table[fridge.instance_id] == {"name": "fridge_0", "label": "fridge A", "category": "fridge", "open": False, "held": False}
+
+
+def test_fridge_content_hidden_until_opened():
+    world = two_rooms()
+    world.set_robot_pose(1.0, 1.0, math.pi / 2)
+    renderer = Renderer()
+    apple = world.get("apple_0").instance_id
+    assert apple not in renderer.render(world).instance
+    world.set_open("fridge_0", True)
+    frame = renderer.render(world)
+    assert apple in frame.instance
+    assert instance_table(world, frame.instance)[world.get("fridge_0").instance_id]["open"] is True
+
+
+def test_open_container_keeps_its_full_box():
+    world = two_rooms()
+    world.set_open("fridge_0", True)
+    g = scene_geometry(world)
+    mine = g.instance == world.get("fridge_0").instance_id
+    lo, hi = world.get("fridge_0").box()
+    assert mine.sum() == 6  # two slabs, four posts
+    assert np.allclose(g.lo[mine].min(axis=0), lo) and np.allclose(g.hi[mine].max(axis=0), hi)
+
+
+def test_closed_door_hides_the_next_room():
+    world = two_rooms()
+    world.set_robot_pose(2.0, 2.0, 0.0)  # facing the door at x = 4 and the table behind it
+    renderer = Renderer()
+    door, table = world.get("door_0").instance_id, world.get("table_0").instance_id
+    carpet = world.class_names.index("carpet")
+    seen = renderer.render(world)
+    assert table in seen.instance and carpet in seen.semantic
+    assert door in seen.instance  # the lintel above the opening
+    world.set_open("door_0", False)
+    shut = renderer.render(world)
+    assert table not in shut.instance and carpet not in shut.semantic
+    v, u = pixel_of(shut, (4.0, 2.0, 1.0))
+    assert shut.instance[v, u] == door and shut.semantic[v, u] == world.class_names.index("door")
+
+
+def test_items_rest_at_their_heights_and_held_items_vanish():
+    world = two_rooms()
+    world.set_robot_pose(4.8, 2.0, 0.0)
+    mug = world.get("mug_0")
+    frame = render(world)
+    v, u = pixel_of(frame, mug.center)
+    assert frame.instance[v, u] == mug.instance_id
+    assert mug.bottom - 1e-3 <= back_project(frame, v, u)[2] <= mug.top + 1e-3
+    assert mug.bottom == pytest.approx(0.75)
+    world.pick("mug_0")
+    after = render(world)
+    assert mug.instance_id not in after.instance
+    assert instance_table(world, after.instance)[mug.instance_id]["held"] is True
+
+
+def test_window_is_see_through_and_range_is_five_metres():
+    world = two_rooms()
+    world.set_robot_pose(2.0, 1.0, -math.pi / 2)  # facing the window in the south wall
+    frame = Renderer(Camera(pitch_deg=0.0)).render(world)
+    v, u = pixel_of(frame, (2.0, 0.0, 1.5))
+    assert np.isnan(frame.depth[v, u]) and frame.semantic[v, u] == 0 and not frame.rgb[v, u].any()
+    v, u = pixel_of(frame, (2.0, 0.0, 0.5))
+    assert frame.semantic[v, u] == world.class_names.index("wall")
+    world.set_robot_pose(0.5, 2.0, 0.0)  # east wall is 7.45 m away: beyond range
+    far = Renderer(Camera(pitch_deg=0.0)).render(world)
+    assert np.isnan(far.depth[128, 128]) and np.nanmax(far.depth) <= 5.0
+
+
+def test_rendering_is_deterministic_and_cached():
+    world = two_rooms()
+    world.set_robot_pose(1.0, 1.0, 0.7)
+    renderer = Renderer()
+    a, b = renderer.render(world), render(world)
+    for name in ("rgb", "depth", "semantic", "instance", "K", "T_world_cam"):
+        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=name == "depth")
+    assert renderer.geometry(world) is renderer.geometry(world)
+    world.set_open("fridge_0", True)
+    assert renderer.geometry(world).n_boxes == scene_geometry(world).n_boxes
