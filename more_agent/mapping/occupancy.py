@@ -21,6 +21,8 @@ UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 """BEV cell values (also used by the synthetic benchmark maps)."""
 
 _MAX_CLASSES = 65535
+_CARVE_CORE = 0.3
+_CARVE_STEP = 0.5
 
 
 def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -37,7 +39,10 @@ def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -
 
 @numba.njit(cache=True)
 def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lut):
-    """Clear the non-free-space voxels that rays pass through before their hit (or max range)."""
+    """Clear the non-free-space voxels that rays pass through before their hit (or max range).
+    Only samples in a voxel's core (within ``_CARVE_CORE`` cells of its centre on every axis)
+    clear it, so rays grazing a surface on their way to a farther hit leave it intact."""
+    step = res * _CARVE_STEP
     h, w = depth.shape
     nx, ny, nz = cls.shape
     for v in range(stride // 2, h, stride):
@@ -52,14 +57,16 @@ def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lu
             dz = (rot[2, 0] * a + rot[2, 1] * b + rot[2, 2]) / norm
             t = 0.0
             while t < length - res:
-                ix = int(np.floor((trans[0] + t * dx - origin[0]) / res))
-                iy = int(np.floor((trans[1] + t * dy - origin[1]) / res))
-                iz = int(np.floor((trans[2] + t * dz - origin[2]) / res))
-                if 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
+                fx = (trans[0] + t * dx - origin[0]) / res
+                fy = (trans[1] + t * dy - origin[1]) / res
+                fz = (trans[2] + t * dz - origin[2]) / res
+                ix, iy, iz = int(np.floor(fx)), int(np.floor(fy)), int(np.floor(fz))
+                t += step
+                core = max(abs(fx - ix - 0.5), abs(fy - iy - 0.5), abs(fz - iz - 0.5))
+                if core < _CARVE_CORE and 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
                     c = cls[ix, iy, iz]
                     if c != 0 and not free_lut[c - 1]:
                         cls[ix, iy, iz] = 0
-                t += res
 
 
 @numba.njit(cache=True)

@@ -171,7 +171,7 @@ FREE_STANDING_CATEGORIES: frozenset[str] = frozenset(
 )
 """Floor furniture placed away from walls; every other floor piece goes against a wall first."""
 
-ROLE_CAPS: dict[str, int] = {"tree": 6, "bush": 8, "boulder": 4, "garden_plant": 6}
+ROLE_CAPS: dict[str, int] = {"tree": 4, "bush": 8, "boulder": 4, "garden_plant": 6}
 """Most instances of a vegetation category kept per room (gardens list up to 64 trees)."""
 
 MAX_PER_CATEGORY = 24

@@ -103,7 +103,7 @@ def generate_floorplan(
              r=robot_radius_m, reach=reach_m, res=resolution_m)
     items = {room: _room_items(objs) for room, objs in rooms.items()}
     for attempt in range(max_attempts):
-        growth = 1.0 + 0.3 * attempt
+        growth = 1.0 + 0.4 * attempt
         rects = _layout(rooms, items, rng, clearance_factor, growth, k)
         runs = _wall_runs(rects)
         doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k)
@@ -232,7 +232,8 @@ def _layout(rooms, items, rng, clearance, growth, k) -> dict[str, Rect]:
         order = sorted(range(len(indoor)), key=lambda i: -areas[indoor[i]] * jitter[i])
         tiles = _squarify([areas[indoor[i]] for i in order], (0.0, 0.0, w, h))
         rects = {indoor[i]: _round(t, 2) for i, t in zip(order, tiles)}
-    sides = [str(s) for s in rng.permutation(["S", "E", "N", "W"])]
+    long_sides, short_sides = (["S", "N"], ["E", "W"]) if w >= h else (["E", "W"], ["S", "N"])
+    sides = [str(s) for s in rng.permutation(long_sides)] + [str(s) for s in rng.permutation(short_sides)]
     offset = dict.fromkeys(sides, 0.0)
     for i, rid in enumerate(outdoor):
         side = sides[i % 4]

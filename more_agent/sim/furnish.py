@@ -61,7 +61,7 @@ def furnish_room(
     *,
     driveway: Rect | None,
     k: dict,
-    attempts: int = 8,
+    attempts: int = 3,
 ) -> list[tuple[object, Vec3, Vec3]] | None:
     """Place ``items`` in the room; returns (item, centre, rotated size) per item, or None on failure."""
     t = k["t"]

@@ -61,7 +61,7 @@ class InstantiationError(UserError):
     """A task cannot be put into a scene; the message names the literal or requirement that failed."""
 
     def __init__(self, message: str, literal: str | None = None) -> None:
-        super().__init__(message)
+        super().__init__(f"cannot satisfy {literal}: {message}" if literal else message)
         self.literal = literal
 
 
@@ -423,4 +423,4 @@ def _verify_init(instance: TaskInstance) -> None:
         head = compile_state([lit], backend, scope=dict(scope), object_map=instance.definition.objects,
                              generate_ground_options=False)[0]
         if not head.evaluate():
-            raise InstantiationError(f"init literal {text} does not hold after placement in {instance.scene}", text)
+            raise InstantiationError(f"it does not hold after placement in {instance.scene}", text)

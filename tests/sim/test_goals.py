@@ -1,0 +1,94 @@
+"""Goal checks through bddl: per-conjunct status, progress over the best ground option, quantifiers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.scene import load_scene
+
+KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
+
+
+def _inst(task: str, seed: int = 0) -> TaskInstance:
+    return instantiate_in_scene(task, load_scene(KITCHEN), seed=seed)
+
+
+def test_conjuncts_and_progress_follow_the_world() -> None:
+    inst = _inst("putting_shopping_away")
+    checker = GoalChecker(inst)
+    status = checker.check()
+    assert not status.all_met and status.progress == 0.0
+    assert len(status.conditions) == 5 and not any(c.satisfied for c in status.conditions)
+    fridge, cabinet = inst.scope["electric_refrigerator.n.01_1"], inst.scope["cabinet.n.01_1"]
+    assert "(inside pack__of__ground_beef_1 fridge_0)" in [c.text for c in status.conditions]
+    moves = [("pack__of__ground_beef_1", fridge), ("cup__of__yogurt_1", fridge), ("canned_food_1", cabinet),
+             ("box__of__cereal_1", cabinet), ("bottle__of__cooking_oil_1", cabinet)]
+    for k, (item, target) in enumerate(moves, start=1):
+        inst.world.place(item, target, "inside")
+        status = checker.check()
+        assert status.progress == pytest.approx(k / 5)
+        done = {c.text for c in status.conditions if c.satisfied}
+        assert f"(inside {item} {target})" in done
+    assert status.all_met
+    lits = checker.ground_literals(status.option_index)
+    assert Literal("inside", ("canned_food_1", cabinet)) in lits
+
+
+def test_exists_forall_and_negation() -> None:
+    inst = _inst("putting_dishes_away_after_cleaning")
+    world = inst.world
+    checker = GoalChecker(inst)
+    plates = sorted(o.name for o in world.items() if o.category == "plate")
+    assert len(plates) == 8
+    cabinets = sorted(o.name for o in world.objects.values() if o.category == "bottom_cabinet")
+    for p in plates[:4]:
+        world.place(p, cabinets[0], "inside")
+    for p in plates[4:]:
+        world.place(p, cabinets[1], "inside")
+    assert not checker.check().all_met  # exists one cabinet holding every plate: not yet
+    for p in plates[4:]:
+        world.place(p, cabinets[0], "inside")
+    world.set_open(cabinets[0], True)
+    status = checker.check()
+    assert not status.all_met  # the cabinet must be closed
+    assert any("(not (open" in c.text and not c.satisfied for c in status.conditions)
+    world.set_open(cabinets[0], False)
+    status = checker.check()
+    assert status.all_met and status.progress == 1.0
+
+
+def test_forpairs() -> None:
+    inst = _inst("line_kitchen_shelves")
+    world, checker = inst.world, GoalChecker(inst)
+    linings = sorted(o.name for o in world.items() if o.category.startswith("lining") or o.synset == "lining.n.01")
+    cabinets = [inst.scope["cabinet.n.01_1"], inst.scope["cabinet.n.01_2"]]
+    world.place(linings[0], cabinets[0], "inside")
+    world.place(linings[1], cabinets[0], "inside")
+    assert not checker.check().all_met  # both in one cabinet: not a pairing
+    world.place(linings[1], cabinets[1], "inside")
+    assert checker.check().all_met
+
+
+def test_ontop_follows_stacks_but_not_containers() -> None:
+    inst = _inst("putting_shopping_away")
+    world = inst.world
+    from more_agent.sim.bddl_backend import is_ontop
+
+    world.place("sack_1", "breakfast_table_0", "ontop")
+    world.place("canned_food_1", "sack_1", "ontop")
+    assert is_ontop(world, "canned_food_1", "breakfast_table_0")
+    world.place("canned_food_1", "sack_1", "inside")
+    assert not is_ontop(world, "canned_food_1", "breakfast_table_0")
+    assert world.is_inside("canned_food_1", "sack_1")
+
+
+def test_check_another_world() -> None:
+    inst, other = _inst("putting_shopping_away"), _inst("putting_shopping_away")
+    checker = GoalChecker(inst)
+    other.world.place("canned_food_1", other.scope["cabinet.n.01_1"], "inside")
+    assert checker.check(other.world).progress == pytest.approx(0.2)
+    assert checker.check(inst.world).progress == 0.0

@@ -1,0 +1,39 @@
+"""``more-agent tasks list / show``: output and exit status 2 without traceback on bad names."""
+
+from __future__ import annotations
+
+from typer.testing import CliRunner
+
+from more_agent.cli import app
+
+runner = CliRunner()
+
+
+def test_list_paper_set() -> None:
+    result = runner.invoke(app, ["tasks", "list", "--set", "more-paper"])
+    assert result.exit_code == 0, result.output
+    assert "putting_shopping_away" in result.output and "55 tasks" in result.output
+
+
+def test_list_unknown_set_exits_2() -> None:
+    result = runner.invoke(app, ["tasks", "list", "--set", "paper"])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+
+
+def test_show_task() -> None:
+    result = runner.invoke(app, ["tasks", "show", "putting_shopping_away"])
+    assert result.exit_code == 0, result.output
+    assert "fridge A" in result.output and "(inside ?pack__of__ground_beef.n.01_1" in result.output
+
+
+def test_show_unknown_task_exits_2_with_closest_names() -> None:
+    result = runner.invoke(app, ["tasks", "show", "putting_shoping_away"])
+    assert result.exit_code == 2
+    assert "putting_shopping_away" in result.output and "Traceback" not in result.output
+
+
+def test_show_in_unsuitable_scene_exits_2_naming_the_literal() -> None:
+    result = runner.invoke(app, ["tasks", "show", "putting_shopping_away", "--scene", "gates_bedroom"])
+    assert result.exit_code == 2
+    assert "inroom" in result.output and "Traceback" not in result.output
