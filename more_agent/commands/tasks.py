@@ -23,7 +23,8 @@ def list_(
     names = task_set(set_) if set_ is not None else task_names()
     data = task_data()["tasks"]
     table = Table(title=f"{len(names)} tasks" + (f" in {set_}" if set_ else ""))
-    for col in ("task", "objects", "goal literals", "instantiable", "scenes"):
+    table.add_column("task", no_wrap=True)
+    for col in ("objects", "goal literals", "instantiable", "scenes"):
         table.add_column(col)
     for name in names:
         e = data[name]

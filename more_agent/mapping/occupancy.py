@@ -6,7 +6,9 @@ disappear), then writes the frame's hits. The BEV takes the highest occupied vox
 below ``bev_max_height_m`` (it may lie below the ground, e.g. a pool): a free-space class there
 (floor, carpet, lawn, driveway) makes the cell FREE, any other class OCCUPIED, none UNKNOWN.
 Voxels of free-space classes are never cleared by passing rays: grazing rays would otherwise
-erase the ground they skim. Depth is z-depth in the OpenCV camera frame (x right, y down, z fwd).
+erase the ground they skim. (Rays grazing a table top on their way to the floor behind do erode
+some of its voxels; the holes are single cells, narrower than the inflation, so the graph is not
+affected.) Depth is z-depth in the OpenCV camera frame (x right, y down, z fwd).
 Grid layout: ``grid[ix, iy]``, cell centre ``origin_xy + (ix + 0.5, iy + 0.5) * resolution_m``.
 """
 
@@ -21,8 +23,6 @@ UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 """BEV cell values (also used by the synthetic benchmark maps)."""
 
 _MAX_CLASSES = 65535
-_CARVE_CORE = 0.3
-_CARVE_STEP = 0.5
 
 
 def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -39,10 +39,8 @@ def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -
 
 @numba.njit(cache=True)
 def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lut):
-    """Clear the non-free-space voxels that rays pass through before their hit (or max range).
-    Only samples in a voxel's core (within ``_CARVE_CORE`` cells of its centre on every axis)
-    clear it, so rays grazing a surface on their way to a farther hit leave it intact."""
-    step = res * _CARVE_STEP
+    """Clear the non-free-space voxels that rays pass through (sampled every ``res``) before
+    their hit (or max range)."""
     h, w = depth.shape
     nx, ny, nz = cls.shape
     for v in range(stride // 2, h, stride):
@@ -57,16 +55,15 @@ def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lu
             dz = (rot[2, 0] * a + rot[2, 1] * b + rot[2, 2]) / norm
             t = 0.0
             while t < length - res:
-                fx = (trans[0] + t * dx - origin[0]) / res
-                fy = (trans[1] + t * dy - origin[1]) / res
-                fz = (trans[2] + t * dz - origin[2]) / res
-                ix, iy, iz = int(np.floor(fx)), int(np.floor(fy)), int(np.floor(fz))
-                t += step
-                core = max(abs(fx - ix - 0.5), abs(fy - iy - 0.5), abs(fz - iz - 0.5))
-                if core < _CARVE_CORE and 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
-                    c = cls[ix, iy, iz]
-                    if c != 0 and not free_lut[c - 1]:
-                        cls[ix, iy, iz] = 0
+                ix = int(np.floor((trans[0] + t * dx - origin[0]) / res))
+                iy = int(np.floor((trans[1] + t * dy - origin[1]) / res))
+                iz = int(np.floor((trans[2] + t * dz - origin[2]) / res))
+                t += res
+                if not (0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz):
+                    continue
+                c = cls[ix, iy, iz]
+                if c != 0 and not free_lut[c - 1]:
+                    cls[ix, iy, iz] = 0
 
 
 @numba.njit(cache=True)

@@ -60,6 +60,8 @@ def unsupported_reason(world: World, lit: Literal) -> str | None:
     if lit.predicate == "open":
         return None if world.get(lit.args[0]).openable else f"{lit.args[0]} is not openable"
     subject, target = lit.args
+    if subject == target:
+        return "an object cannot be in or on itself"
     if subject == ROBOT_NAME:
         ok = lit.predicate == "ontop" and not lit.negated and world.get(target).kind == "floor"
         return None if ok else "the robot can only be asked to stand in a room"
@@ -92,14 +94,37 @@ def order_literals(literals: list[Literal]) -> list[Literal]:
     return [next(rest) if _group(lit) == 2 else lit for lit in ordered]
 
 
-def choose_option(goals: GoalChecker, world: World) -> int:
-    """The ground goal option with the fewest literals the oracle cannot achieve, then the fewest unmet."""
+def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
+    """Drop duplicates and resolve one subject with two placements through the stack they imply.
+
+    ``ontop(a, b)`` with ``b`` an item and ``ontop(a, c)`` (or ``inside(a, c)``) both hold when ``b``
+    goes onto (into) ``c``, since the relations follow stacks; so the second becomes ``ontop(b, c)``
+    (``inside(b, c)``). Likewise ``inside(a, b)`` and ``inside(a, c)`` become ``inside(b, c)``.
+    Placing ``a`` on ``c`` directly would undo the first literal.
+    """
+    out: list[Literal] = []
+    for lit in literals:
+        if lit.predicate in ("inside", "ontop") and not lit.negated and lit.args[0] != ROBOT_NAME:
+            subject, target = lit.args
+            via = next((o for o in literals if not o.negated and o.args[0] == subject and o.args[1] != target
+                        and o.predicate in ("inside", "ontop") and world.get(o.args[1]).movable
+                        and (o.predicate == "ontop" or lit.predicate == "inside")), None)
+            if via is not None:
+                lit = Literal(lit.predicate, (via.args[1], target))
+        if lit not in out:
+            out.append(lit)
+    return out
+
+
+def choose_option(goals: GoalChecker, world: World, exclude: set[int] = frozenset()) -> int | None:
+    """The ground goal option (not in ``exclude``) with the fewest literals the oracle cannot achieve, then the fewest unmet."""
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)
         unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
         unmet = sum(unsupported_reason(world, lit) is None and not literal_holds(world, lit) for lit in lits)
         return unsupported, unmet, i
-    return min(range(goals.n_options), key=cost)
+    candidates = [i for i in range(goals.n_options) if i not in exclude]
+    return min(candidates, key=cost) if candidates else None
 
 
 class OraclePlanner:
@@ -114,13 +139,26 @@ class OraclePlanner:
         """Choose the goal option and order its literals."""
         self._world = context.instance.world
         self._goals = context.goals
-        literals = context.goals.ground_literals(choose_option(context.goals, self._world))
-        self._skipped = {lit: why for lit in literals if (why := unsupported_reason(self._world, lit)) is not None}
-        self._literals = [lit for lit in order_literals(literals) if lit not in self._skipped]
+        self._tried: set[int] = set()
+        self._adopt_next_option()
         self._door: str | None = None
+        self._intent: Literal | None = None
+        """The literal the held item was grasped for."""
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
         self._observed: set[str] = set()
+
+    def _adopt_next_option(self) -> bool:
+        """Work on the best ground option not tried yet; False when every option has been tried."""
+        option = choose_option(self._goals, self._world, exclude=self._tried)
+        if option is None:
+            return False
+        self._tried.add(option)
+        literals = self._goals.ground_literals(option)
+        self._skipped = {lit: why for lit in literals if (why := unsupported_reason(self._world, lit)) is not None}
+        supported = [lit for lit in literals if lit not in self._skipped]
+        self._literals = order_literals(merge_placements(self._world, supported))
+        return True
 
     def observe(self) -> None:
         """The oracle reads the world directly: nothing to sense."""
@@ -139,8 +177,12 @@ class OraclePlanner:
         if self._goals.check(self._world).all_met:
             return HighLevelAction(DONE, note="all goal conditions hold")
         pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
-        if not pending:
-            return HighLevelAction(DONE, note=self._explain_unmet())
+        while not pending:
+            # bddl's ground options can be partly infeasible (e.g. '(ontop log_1 log_1)'): the next may finish the job.
+            explanation = self._explain_unmet()
+            if not self._adopt_next_option():
+                return HighLevelAction(DONE, note=explanation)
+            pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
@@ -168,8 +210,9 @@ class OraclePlanner:
     def _next(self, pending: list[Literal]) -> HighLevelAction:
         held = self._world.robot.held
         if held is not None:
-            # Finish what the hand holds when its own placement is ready.
-            for lit in pending:
+            # Finish what the hand holds: the placement it was grasped for first, else any that is ready.
+            intent = [self._intent] if self._intent in pending else []
+            for lit in intent + pending:
                 if lit.args[0] == held and not lit.negated and lit.predicate != "open":
                     if self._blocker(lit.args[1], lit.predicate) is None:
                         return self._act(f"go_to_and_place_{lit.predicate}", lit.args[1], lit)
@@ -190,7 +233,7 @@ class OraclePlanner:
             return self._act("navigate_to", target, lit)
         if lit.negated:
             if held == subject:
-                return self._put_down(avoid=target)
+                return self._put_down()
             return self._put_down() if held is not None else self._fetch(subject, lit)
         blocker = self._blocker(target, lit.predicate)
         if held == subject:
@@ -211,6 +254,7 @@ class OraclePlanner:
         hider = self._world.enclosing_closed_container(subject)
         if hider is not None:
             return self._act("go_to_and_open", hider.name, lit)
+        self._intent = lit
         return self._act("go_to_and_grasp", subject, lit)
 
     def _blocker(self, target: str, predicate: str) -> str | None:
@@ -231,12 +275,17 @@ class OraclePlanner:
             return None
         return blocking_door(self._world, start, goals)
 
-    def _put_down(self, avoid: str | None = None) -> HighLevelAction:
-        """Free the hand: put the held item on the floor of the room the robot is in (or the nearest other)."""
+    def _put_down(self) -> HighLevelAction:
+        """Free the hand: put the held item on the floor of the room the robot is in (or the nearest other).
+
+        Floors the item must not be on (a ``not ontop`` goal) are avoided.
+        """
         world = self._world
+        held = world.robot.held
+        avoid = {lit.args[1] for lit in self._literals if lit.negated and lit.predicate == "ontop" and lit.args[0] == held}
         room = world.room_at(world.robot.x, world.robot.y)
         floors = sorted(
-            (o for o in world.objects.values() if o.kind == "floor" and o.name != avoid),
+            (o for o in world.objects.values() if o.kind == "floor" and o.name not in avoid),
             key=lambda o: (o.room != room, float(((o.center[:2] - world.robot.xy) ** 2).sum())),
         )
         return HighLevelAction("go_to_and_place_ontop", (floors[0].name,), note="free the hand")

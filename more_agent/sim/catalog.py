@@ -102,10 +102,20 @@ def category_size(category: str) -> Vec3:
     return (float(med[0]), float(med[1]), float(med[2]))
 
 
+@cache
+def _category_to_synsets() -> dict[str, tuple[str, ...]]:
+    """Inverse of the taxonomy's synset -> categories, built once (its own lookup scans every synset)."""
+    tax = taxonomy()
+    out: dict[str, list[str]] = {}
+    for synset in sorted(tax.taxonomy.nodes):
+        for category in tax.get_categories(synset):
+            out.setdefault(category, []).append(synset)
+    return {c: tuple(s) for c, s in out.items()}
+
+
 def category_synsets(category: str) -> list[str]:
     """The synset(s) a category belongs to (one in bddl 3.6), or [] if the taxonomy lacks it."""
-    synset = taxonomy().get_synset_from_category(category)
-    return [synset] if synset else []
+    return list(_category_to_synsets().get(category, ()))
 
 
 def synset_categories(synset: str) -> list[str]:

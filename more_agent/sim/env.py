@@ -132,12 +132,14 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             self._goal = None
             self._spawn()
         self._steps, self._low_level_steps = 0, 0
+        start = self.world.robot
+        x, y, yaw = start.x, start.y, start.yaw
         turn_frames = [self._record()]
         angles = motion.full_turn_angles()
-        for i, angle in enumerate(angles):
+        for angle in angles[:-1]:
             motion.turn(self.world, angle)
-            if i < len(angles) - 1:
-                turn_frames.append(self._record())
+            turn_frames.append(self._record())
+        self.world.set_robot_pose(x, y, yaw)  # the last turn closes the circle (without rounding drift)
         self._low_level_steps = len(angles)
         status = self._status()
         self._progress = status.progress if status is not None else 0.0

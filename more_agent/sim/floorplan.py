@@ -5,7 +5,7 @@ Rooms get an area from their type and their furniture; indoor rooms tile the hou
 doors sit on shared walls along a random spanning tree of the adjacency graph (plus a few extra),
 windows in exterior walls. Furniture goes against walls or free-standing with walkways, and each
 room is checked on a raster so that a robot disc reaches every piece; a room that fails is
-refurnished, a scene that fails is laid out again with more area. Same (name, seed) -> same plan.
+refurnished, and if it still fails the scene is laid out again with that room larger. Same (name, seed) -> same plan.
 """
 
 from __future__ import annotations
@@ -73,7 +73,11 @@ class _Keepout:
 
 
 class _Retry(Exception):
-    """This layout attempt cannot hold its rooms' furniture; try again with more area."""
+    """This layout attempt cannot hold one room's furniture; lay out again with that room larger."""
+
+    def __init__(self, room: str) -> None:
+        super().__init__(room)
+        self.room = room
 
 
 def generate_floorplan(
@@ -93,7 +97,7 @@ def generate_floorplan(
     robot_radius_m: float = 0.3,
     reach_m: float = 1.0,
     resolution_m: float = 0.075,
-    max_attempts: int = 8,
+    max_attempts: int = 12,
 ) -> Scene:
     """Lay out ``rooms`` (room id -> {'category-model': count}, as in bddl) as a Scene.
 
@@ -102,17 +106,19 @@ def generate_floorplan(
     k = dict(t=wall_thickness_m, walk=walkway_m, door_w=door_width_m, door_clear=door_clear_m,
              r=robot_radius_m, reach=reach_m, res=resolution_m)
     items = {room: _room_items(objs) for room, objs in rooms.items()}
-    for attempt in range(max_attempts):
-        growth = 1.0 + 0.4 * attempt
+    growth = dict.fromkeys(rooms, 1.0)
+    for _ in range(max_attempts):
         rects = _layout(rooms, items, rng, clearance_factor, growth, k)
         runs = _wall_runs(rects)
         doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k)
         if doors is None:
+            growth = {r: g * 1.1 for r, g in growth.items()}
             continue
-        windows = _place_windows(runs, doors, rects, rng)
+        windows = _place_windows(runs, doors, rng, k)
         try:
             furniture, patches = _furnish_all(rects, items, doors, windows, rng, k)
-        except _Retry:
+        except _Retry as e:
+            growth[e.room] *= 1.4  # only the room that could not hold its furniture grows
             continue
         walls = _walls(runs, rects, doors, windows, wall_height_m, k)
         allx = [v for r in rects.values() for v in (r[0], r[2])]
@@ -215,9 +221,9 @@ def _squarify(areas: list[float], rect: Rect) -> list[Rect]:
     return out
 
 
-def _layout(rooms, items, rng, clearance, growth, k) -> dict[str, Rect]:
+def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[str, Rect]:
     """Room rectangles: indoor rooms tile the house, outdoor ones are bands along its sides."""
-    areas = {rid: _room_area(rid, items[rid], rng, clearance, k) * growth for rid in rooms}
+    areas = {rid: _room_area(rid, items[rid], rng, clearance, k) * growth[rid] for rid in rooms}
     indoor = [rid for rid in rooms if _room_type(rid) not in OUTDOOR_TYPES]
     outdoor = [rid for rid in rooms if _room_type(rid) in OUTDOOR_TYPES]
     rects: dict[str, Rect] = {}
@@ -312,20 +318,24 @@ def _on_run(run: _Run, center: tuple[float, float]) -> float | None:
     return along if abs(across - run.coord) < 1e-6 and run.lo < along < run.hi else None
 
 
-def _place_windows(runs, doors, rects, rng) -> list[Window]:
-    """One window per exterior wall run of an indoor room (to the void or a garden) without a door."""
+def _place_windows(runs, doors, rng, k) -> list[Window]:
+    """One window per exterior wall run of an indoor room (to the void or a garden), clear of doors."""
     out: list[Window] = []
     for run in runs:
         sides = [r for r in (run.neg, run.pos) if r]
         indoor = [r for r in sides if _room_type(r) not in OUTDOOR_TYPES]
         if len(indoor) != 1 or run.hi - run.lo < 1.8:
             continue
-        if any(_on_run(run, d.center) is not None for d in doors):
-            continue
+        busy = [a for a in (_on_run(run, d.center) for d in doors) if a is not None]
         width = min(1.5, run.hi - run.lo - 2 * _END_MARGIN_M)
         slack = max(run.hi - run.lo - 2 * _END_MARGIN_M - width, 0.0)
-        c = run.lo + _END_MARGIN_M + width / 2 + float(rng.random()) * slack
-        b = (c - width / 2, run.coord - 0.05, c + width / 2, run.coord + 0.05)
+        for _ in range(10):  # keep clear of the run's doors
+            c = run.lo + _END_MARGIN_M + width / 2 + float(rng.random()) * slack
+            if all(abs(c - a) > width / 2 + 0.45 + _END_MARGIN_M for a in busy):
+                break
+        else:
+            continue
+        b = (c - width / 2, run.coord - k["t"] / 2, c + width / 2, run.coord + k["t"] / 2)
         bounds = b if run.axis == "x" else (b[1], b[0], b[3], b[2])
         out.append(Window(id=f"window_{len(out)}", bounds=_round(bounds), sill=WINDOW_SILL_M,
                           top=WINDOW_TOP_M, rooms=tuple(indoor + [r for r in sides if r not in indoor])))
@@ -399,7 +409,7 @@ def _furnish_all(rects, items, doors, windows, rng, k) -> tuple[list[Furniture],
             patches.append(GroundPatch(room=rid, bounds=_round(driveway), ground="driveway"))
         placed = furnish_room(rect, items[rid], keep, rng, driveway=driveway, k=k)
         if placed is None:
-            raise _Retry
+            raise _Retry(rid)
         for it, center, size in placed:
             if it.role == "carpet":
                 half = (size[0] / 2, size[1] / 2)

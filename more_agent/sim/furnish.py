@@ -24,6 +24,7 @@ _MOUNT_LEVELS = 3
 _LEVEL_STEP_M = 0.45
 _MAX_MOUNT_TOP_M = 2.5
 _EDGE_INSET_M = 0.05
+_WALL_CLEAR_M = 0.01  # between a wall face and the furniture against it
 
 
 class _Obstacles:
@@ -64,8 +65,8 @@ def furnish_room(
     attempts: int = 3,
 ) -> list[tuple[object, Vec3, Vec3]] | None:
     """Place ``items`` in the room; returns (item, centre, rotated size) per item, or None on failure."""
-    t = k["t"]
-    inner = (rect[0] + t / 2, rect[1] + t / 2, rect[2] - t / 2, rect[3] - t / 2)
+    m = k["t"] / 2 + _WALL_CLEAR_M
+    inner = (rect[0] + m, rect[1] + m, rect[2] - m, rect[3] - m)
     for _ in range(attempts):
         placed = _try_furnish(inner, items, keepouts, rng, driveway, k)
         if placed is not None and _reachable(inner, placed, keepouts, k):

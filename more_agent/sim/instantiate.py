@@ -50,6 +50,9 @@ DOOR_KEEPOUT_M = 0.6
 """Floor items stay this far from door openings so doors stay passable."""
 
 SAMPLE_TRIES = 400
+"""Random draws before falling back to a raster scan of the room."""
+
+RASTER_STEP_M = 0.05
 
 GROUND_CATEGORIES = {"floor": "floors", "driveway": "driveway", "lawn": "lawn", "carpet": "carpet"}
 """World ground class -> BEHAVIOR category; scopes of these bind to a room's floor object."""
@@ -394,7 +397,17 @@ def free_floor_spot(
         p = rng.uniform(lo, hi)
         if not np.any(np.all((boxes[:, :2] < p + half) & (boxes[:, 2:] > p - half), axis=1)):
             return float(p[0]), float(p[1])
-    return None
+    # Crowded room: scan a raster of candidate centres and draw among the free ones.
+    gx, gy = np.meshgrid(np.arange(lo[0], hi[0], RASTER_STEP_M), np.arange(lo[1], hi[1], RASTER_STEP_M))
+    pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
+    blocked = np.zeros(len(pts), dtype=bool)
+    for box in boxes:
+        blocked |= np.all((box[:2] < pts + half) & (box[2:] > pts - half), axis=1)
+    free = pts[~blocked]
+    if len(free) == 0:
+        return None
+    p = free[rng.integers(len(free))]
+    return float(p[0]), float(p[1])
 
 
 def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:

@@ -1,0 +1,316 @@
+"""The LLM planners: MORE and the MoMa-LLM baselines, as configurations of one class.
+
+One high-level step (paper Sec. III-B/C, MPC style): build the scene graph from everything sensed,
+label new regions with the cheaper room model, put the graph into words, let the LLM filter it to
+the task-relevant subgraph (MORE only), ask the LLM for one subpolicy call given the task, the
+subgraph, the robot's room and held object, the history (last five actions and every failed one)
+and the last feedback, then run that subpolicy. Planners differ only in their
+:class:`LLMPlannerConfig`:
+
+- ``more``: filtering, alphabetical instance ids, spatial relations;
+- ``moma-llm``: no filtering, objects by class, no spatial relations;
+- ``moma-llm-sr``: ``moma-llm`` with spatial relations.
+
+The class implements the :class:`~more_agent.planners.base.Planner` protocol. LLM transport errors
+(timeouts, a server gone, a replay miss) propagate as :class:`~more_agent.llm.errors.LLMError` for
+the episode loop to record; an answer still invalid after the bounded re-asks becomes an ``invalid``
+action whose failure is fed back to the next step, so LLM output never crashes an episode.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from more_agent.eval.record import ActionRecord, LLMUsage
+from more_agent.llm import (
+    DEFAULT_SKILLS,
+    FilterAnswer,
+    InvalidAnswer,
+    LLMClient,
+    LLMConfig,
+    LLMConfigError,
+    PlanAnswer,
+    RoomLabelAnswer,
+    UsageMeter,
+    ask_validated,
+    configured_llm,
+    filter_messages,
+    load_llm_config,
+    make_client,
+    parse_filter_answer,
+    parse_plan_answer,
+    parse_room_label,
+    plan_messages,
+    room_messages,
+    room_spec,
+)
+from more_agent.llm.completion import Completion
+from more_agent.mapping import MappingConfig
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.language import LanguageOptions, SceneView, scene_view
+from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
+from more_agent.planners.policies.skills import pick_target
+from more_agent.scene_graph import SceneGraph
+from more_agent.sim.actions import ActionResult, FailureReason
+
+log = logging.getLogger(__name__)
+
+INVALID = "invalid"
+"""Name of the action recorded when the LLM gave no usable answer after the re-asks."""
+
+ROOM_TYPES: tuple[str, ...] = (
+    "bar", "bathroom", "bedroom", "biology_lab", "break_room", "chemistry_lab", "childs_room", "classroom", "closet",
+    "computer_lab", "conference_hall", "copy_room", "corridor", "dining_room", "empty_room", "entryway",
+    "exercise_room", "garage", "garden", "grocery_store", "gym", "hammam", "infirmary", "kitchen", "living_room",
+    "lobby", "locker_room", "meeting_room", "pantry_room", "phone_room", "playroom", "private_office", "sauna",
+    "shared_office", "spa", "staircase", "storage_room", "television_room", "utility_room",
+)
+"""BEHAVIOR-1K room types (every type in bddl's combined_room_object_list.json): the room classifier's choices."""
+
+
+class LLMPlannerConfig(BaseModel):
+    """What distinguishes MORE from the MoMa-LLM baselines, and the knobs they share."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    name: str = Field(description="Planner name as registered, e.g. 'more'.")
+    filtering: bool = Field(description="Ask the LLM for the task-relevant subgraph before planning (MORE).")
+    language: LanguageOptions = Field(description="Instance ids and spatial relations in the scene text.")
+    max_reasks: int = Field(default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action.")
+    room_types: tuple[str, ...] = Field(default=ROOM_TYPES, description="Room labels the room classifier chooses from.")
+    policy: PolicyConfig = Field(default_factory=PolicyConfig, description="Subpolicy knobs.")
+    mapping: MappingConfig = Field(default_factory=MappingConfig, description="Mapping and scene-graph knobs.")
+
+
+PLANNER_CONFIGS: dict[str, LLMPlannerConfig] = {
+    "more": LLMPlannerConfig(name="more", filtering=True, language=LanguageOptions(instance_ids=True, spatial_relations=True)),
+    "moma-llm": LLMPlannerConfig(
+        name="moma-llm", filtering=False, language=LanguageOptions(instance_ids=False, spatial_relations=False)
+    ),
+    "moma-llm-sr": LLMPlannerConfig(
+        name="moma-llm-sr", filtering=False, language=LanguageOptions(instance_ids=False, spatial_relations=True)
+    ),
+}
+"""The paper's LLM planners by name."""
+
+
+@dataclass(frozen=True)
+class LLMClients:
+    """The planning model and the (cheaper) room-classification model."""
+
+    plan: LLMClient
+    room: LLMClient
+
+
+def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients:
+    """Clients for ``llm`` (else the configured LLM) per the LLM config; raises LLMConfigError without one."""
+    config = config or load_llm_config()
+    spec = configured_llm(config, llm)
+    if spec is None:
+        raise LLMConfigError(
+            "this planner needs an LLM: pass --llm openai:MODEL (or llamacpp:PATH.gguf) or set MORE_AGENT_LLM"
+        )
+    rooms = room_spec(spec, config)
+    plan = make_client(spec, config)
+    return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config))
+
+
+@dataclass(frozen=True)
+class StepTrace:
+    """What the planner saw and asked in one step (for logs, benchmarks and tests)."""
+
+    scene_text: str
+    """The full scene description."""
+    planning_text: str
+    """The scene description the planner was given (the filtered one under filtering)."""
+    completions: tuple[Completion, ...]
+    """Every LLM answer of the step (room labels, filter, plan, re-asks)."""
+
+
+class LLMPlanner:
+    """MORE / MoMa-LLM: the :class:`~more_agent.planners.base.Planner` protocol over an LLM (module docstring)."""
+
+    def __init__(self, config: LLMPlannerConfig, clients: LLMClients) -> None:
+        self.name = config.name
+        self.config = config
+        self.clients = clients
+        self.usage = UsageMeter()
+        self.body: Embodiment | None = None
+        self.task = ""
+        self.history: list[ActionRecord] = []
+        self.feedback = ""
+        self.graph: SceneGraph | None = None
+        self.view: SceneView | None = None
+        self.trace: StepTrace | None = None
+        self._reported_steps = 0
+        self._reported_path = 0
+
+    # -- Planner protocol ---------------------------------------------------------------------
+    def reset(self, context: EpisodeContext) -> None:
+        """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
+        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
+        self.task = context.instance.description
+        self.history, self.feedback = [], ""
+        self.usage = UsageMeter()
+        self._reported_steps, self._reported_path = 0, 1
+        self.body.sense()
+        self.body.look_around()
+
+    def observe(self) -> None:
+        """Build the scene graph, label new regions, put it into words."""
+        body = self._body()
+        graph = body.build()
+        labels = self._classify_rooms(graph)
+        if labels:
+            body.builder.set_room_labels(labels)
+            graph = graph.with_room_labels(labels)
+        self.graph = graph
+        self.view = scene_view(graph, self.config.language)
+
+    def decide(self) -> HighLevelAction:
+        """Filter (MORE) and plan: the next subpolicy call, or ``invalid`` when no valid answer came."""
+        view = self._view()
+        completions: list[Completion] = []
+        planning_view = self._filter(view, completions) if self.config.filtering else view
+        messages = plan_messages(
+            task=self.task, scene=planning_view.text(), robot_room=view.robot_room, held_object=view.held,
+            history=self.history, feedback=self.feedback,
+        )
+        rooms, objects = [r.name for r in view.rooms], view.object_names()
+        try:
+            answer = ask_validated(
+                self.clients.plan, messages, PlanAnswer,
+                lambda a: parse_plan_answer(a, DEFAULT_SKILLS, rooms, objects),
+                max_reasks=self.config.max_reasks, purpose="plan",
+            )
+        except InvalidAnswer as e:
+            self._count(completions + list(e.completions), view, planning_view)
+            return HighLevelAction(name=INVALID, note=e.reason)
+        self._count(completions + list(answer.completions), view, planning_view)
+        planned = answer.value
+        return HighLevelAction(name=planned.skill, arguments=planned.arguments, note=planned.reasoning)
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        """Run the subpolicy; the result counts the low-level steps and path since the last result
+        (so the initial full turn is part of the first step's)."""
+        result = self._run(action)
+        self.history.append(ActionRecord(
+            step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
+            feedback=result.feedback,
+        ))
+        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
+        body = self._body()
+        steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
+        path = body.trajectory[self._reported_path - 1:] if len(body.trajectory) > self._reported_path else []
+        self._reported_path = len(body.trajectory)
+        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
+                            path=path, blocking=result.blocking)
+
+    def observed_objects(self) -> set[str]:
+        """World object names the robot has seen."""
+        return set(self.body.observed) if self.body is not None else set()
+
+    def llm_usage(self) -> LLMUsage:
+        """LLM traffic of this episode so far."""
+        return LLMUsage(**self.usage.totals())
+
+    # -- steps ----------------------------------------------------------------------------------
+    def _classify_rooms(self, graph: SceneGraph) -> dict[str, str]:
+        """Room labels for regions without one that have objects (one call each with the room model);
+        a region whose answer stays invalid is left unlabelled and asked again next step."""
+        labels: dict[str, str] = {}
+        for rid, region in sorted(graph.regions.items()):
+            names = sorted({graph.objects[o].category for o in region.object_ids if graph.objects[o].category != "door"})
+            if region.room_label is not None or not names:
+                continue
+            try:
+                answer = ask_validated(
+                    self.clients.room, room_messages(names, self.config.room_types), RoomLabelAnswer,
+                    lambda a: parse_room_label(a, self.config.room_types),
+                    max_reasks=self.config.max_reasks, purpose="room",
+                )
+            except InvalidAnswer as e:
+                self._add(e.completions)
+                log.info("room label of %s stays unknown: %s", rid, e.reason)
+                continue
+            self._add(answer.completions)
+            labels[rid] = answer.value
+        return labels
+
+    def _filter(self, view: SceneView, completions: list[Completion]) -> SceneView:
+        """The task-relevant subgraph (paper Sec. III-B); the full view when nothing to filter or no usable answer."""
+        if not any(r.objects for r in view.rooms):
+            return view
+        try:
+            answer = ask_validated(
+                self.clients.plan, filter_messages(self.task, view.text()), FilterAnswer,
+                lambda a: parse_filter_answer(a, view.names()),
+                max_reasks=self.config.max_reasks, purpose="filter",
+            )
+        except InvalidAnswer as e:
+            completions.extend(e.completions)
+            log.info("filter answer unusable, planning on the full scene: %s", e.reason)
+            return view
+        completions.extend(answer.completions)
+        return view.filtered(answer.value, always={view.robot_room})
+
+    def _run(self, action: HighLevelAction) -> ActionResult:
+        """Dispatch one decided action to its subpolicy."""
+        if action.name == DONE:
+            return ActionResult(ok=True, reason=None, feedback="done")
+        if action.name == INVALID:
+            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
+        body, graph, view = self._body(), self._graph(), self._view()
+        room = action.arguments[0]
+        if action.name == "explore":
+            return explore(body, graph, view.room(room).region_id, room)
+        target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
+        if target is None:
+            return ActionResult(ok=False, reason=FailureReason.UNKNOWN_OBJECT,
+                                feedback=f"unknown object {action.arguments[1]}")
+        if action.name == "navigate":
+            return navigate(body, graph, target)
+        return go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
+
+    # -- bookkeeping ----------------------------------------------------------------------------
+    def _count(self, completions: Sequence[Completion], view: SceneView, planning_view: SceneView) -> None:
+        self._add(completions)
+        self.trace = StepTrace(scene_text=view.text(), planning_text=planning_view.text(), completions=tuple(completions))
+
+    def _add(self, completions: Sequence[Completion]) -> None:
+        for c in completions:
+            self.usage.add(c)
+
+    def _body(self) -> Embodiment:
+        if self.body is None:
+            raise RuntimeError("reset() must be called before the first step")
+        return self.body
+
+    def _graph(self) -> SceneGraph:
+        if self.graph is None:
+            raise RuntimeError("observe() must be called before decide() / execute()")
+        return self.graph
+
+    def _view(self) -> SceneView:
+        if self.view is None:
+            raise RuntimeError("observe() must be called before decide() / execute()")
+        return self.view
+
+
+def make_more(llm: str | None) -> LLMPlanner:
+    """Registry factory of ``more``."""
+    return LLMPlanner(PLANNER_CONFIGS["more"], make_clients(llm))
+
+
+def make_moma_llm(llm: str | None) -> LLMPlanner:
+    """Registry factory of ``moma-llm``."""
+    return LLMPlanner(PLANNER_CONFIGS["moma-llm"], make_clients(llm))
+
+
+def make_moma_llm_sr(llm: str | None) -> LLMPlanner:
+    """Registry factory of ``moma-llm-sr``."""
+    return LLMPlanner(PLANNER_CONFIGS["moma-llm-sr"], make_clients(llm))

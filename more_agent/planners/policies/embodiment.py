@@ -1,0 +1,134 @@
+"""The robot as the subpolicies drive it: world, camera, scene-graph builder and step accounting.
+
+Every low-level action goes through :mod:`more_agent.sim.motion` (7.5 cm forward moves, turns of at
+most 35 degrees) and is counted; frames are rendered and fused into the
+:class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
+moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
+Perception is ground truth as in the paper (S.2): instance attributes are read from the world.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from more_agent.mapping import MappingConfig
+from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
+from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
+from more_agent.sim.motion import full_turn_angles, move_forward, turn
+from more_agent.sim.navgrid import XY
+from more_agent.sim.render import Renderer, instance_table
+from more_agent.sim.world import World
+
+
+class PolicyConfig(BaseModel):
+    """Knobs of the subpolicies, in physical units."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    plan_inflation_m: float = Field(
+        default=0.25, gt=0, description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin)."
+    )
+    sense_every_steps: int = Field(default=4, ge=1, description="Fuse a frame after this many forward moves on a path.")
+    max_replans: int = Field(default=3, ge=0, description="Replans on the updated map after a blocked move before giving up.")
+    goal_snap_m: float = Field(
+        default=1.0, gt=0, description="A goal off the traversable map moves to the nearest traversable cell within this distance."
+    )
+    visited_frontier_m: float = Field(
+        default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
+    )
+    look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
+
+
+class Embodiment:
+    """World + renderer + scene-graph builder, with low-level step, trajectory and observation accounting."""
+
+    def __init__(
+        self,
+        world: World,
+        *,
+        config: PolicyConfig | None = None,
+        mapping: MappingConfig | None = None,
+        renderer: Renderer | None = None,
+    ) -> None:
+        self.world = world
+        self.config = config or PolicyConfig()
+        self.renderer = renderer or Renderer()
+        self.builder = SceneGraphBuilder(world.class_names, mapping)
+        self.low_level_steps = 0
+        self.trajectory: list[XY] = [self.xy]
+        self.observed: set[str] = set()
+        """World object names seen so far (for the rTP metric)."""
+        self.visited_frontiers: list[XY] = []
+
+    @property
+    def xy(self) -> XY:
+        """Robot base position."""
+        return (float(self.world.robot.x), float(self.world.robot.y))
+
+    def sense(self) -> None:
+        """Render a frame from the current pose and fuse it into the scene-graph builder."""
+        frame = self.renderer.render(self.world)
+        table = instance_table(self.world, frame.instance)
+        infos = {
+            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"])
+            for i, d in table.items()
+        }
+        self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
+        self.observed.update(d["name"] for d in table.values())
+
+    def build(self) -> SceneGraph:
+        """The scene graph of everything sensed so far, from the robot's position."""
+        return self.builder.build(self.xy)
+
+    def turn_by(self, angle: float) -> None:
+        """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense."""
+        angle = math.atan2(math.sin(angle), math.cos(angle))
+        n = math.ceil(abs(angle) / MAX_TURN_RAD - 1e-9)
+        for _ in range(n):
+            turn(self.world, angle / n)
+            self.low_level_steps += 1
+        if n:
+            self.sense()
+
+    def face(self, xy: Sequence[float]) -> None:
+        """Turn towards a point (no-op when standing on it)."""
+        dx, dy = xy[0] - self.world.robot.x, xy[1] - self.world.robot.y
+        if math.hypot(dx, dy) > 1e-6:
+            self.turn_by(math.atan2(dy, dx) - self.world.robot.yaw)
+
+    def look_around(self) -> None:
+        """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
+        for angle in full_turn_angles():
+            turn(self.world, angle)
+            self.low_level_steps += 1
+            self.sense()
+
+    def follow(self, waypoints: Sequence[XY]) -> bool:
+        """Drive along a polyline with low-level moves; False as soon as a move is blocked."""
+        moved = 0
+        for target in waypoints[1:]:
+            self.face(target)
+            remaining = math.dist(self.xy, target)
+            while remaining > 1e-6:
+                result = move_forward(self.world, min(FORWARD_STEP_M, remaining))
+                self.low_level_steps += 1
+                if not result.ok:
+                    self.sense()
+                    return False
+                remaining -= result.applied
+                moved += 1
+                self.trajectory.append(self.xy)
+                if moved % self.config.sense_every_steps == 0:
+                    self.sense()
+        self.sense()
+        return True
+
+    def record_jump(self, path: Sequence[XY], steps: int) -> None:
+        """Account for a motion a magic action made (its path and low-level steps), then sense."""
+        self.low_level_steps += steps
+        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
+        if path:
+            self.sense()

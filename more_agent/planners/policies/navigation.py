@@ -1,0 +1,59 @@
+"""Paths on the agent's own map: the BEV occupancy of the scene graph, inflated, as a navigation grid.
+
+Only cells the robot has seen free count as traversable, kept ``plan_inflation_m`` away from mapped
+obstacles (unknown space is not traversable but does not inflate). Shortest paths use the same
+8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.navgrid.shortest_path`,
+an optimal search like A* with an admissible heuristic), here on what the agent knows.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from scipy import ndimage
+
+from more_agent.mapping import FREE, OCCUPIED
+from more_agent.scene_graph import OccupancyMap, SceneGraph
+from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
+
+
+def agent_nav_grid(occupancy: OccupancyMap, *, inflation_m: float) -> NavGrid:
+    """The traversable raster of the agent's map: seen-free cells at least ``inflation_m`` from obstacles."""
+    grid = np.asarray(occupancy.grid).T  # model is [ix, iy]; NavGrid is [row = y, col = x]
+    clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
+    free = (grid == FREE) & (clearance > inflation_m)
+    return NavGrid(
+        free=free, origin=tuple(occupancy.origin_xy), resolution_m=occupancy.resolution_m,
+        closed_doors=frozenset(), door_cells={},
+    )
+
+
+def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | None]:
+    """Each goal moved to its nearest traversable cell centre, or None when that is farther than ``max_m``."""
+    out: list[XY | None] = []
+    for g in goals:
+        cell = grid.snap(*g)
+        xy = grid.to_xy(*cell) if cell is not None else None
+        out.append(xy if xy is not None and math.dist(xy, g) <= max_m else None)
+    return out
+
+
+def path_to_nearest(grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: float) -> tuple[PathResult, int | None]:
+    """Shortest path from ``start`` to the nearest reachable goal (goals snapped first) and that goal's index."""
+    snapped = snap_goals(grid, goals, snap_m)
+    usable = [i for i, g in enumerate(snapped) if g is not None]
+    if not usable:
+        return shortest_path(grid, start, []), None
+    result = shortest_path(grid, start, [snapped[i] for i in usable])  # type: ignore[misc]
+    return result, (usable[result.goal_index] if result.goal_index is not None else None)
+
+
+def object_goal(graph: SceneGraph, object_id: str) -> XY | None:
+    """The Voronoi node closest to an object (paper: navigate(room, object)); None on an empty graph."""
+    if len(graph.nav.node_xy) == 0:
+        return None
+    x, y, _ = graph.objects[object_id].position
+    node = graph.closest_node((x, y))
+    return (float(graph.nav.node_xy[node][0]), float(graph.nav.node_xy[node][1]))

@@ -1,0 +1,121 @@
+"""The paper's subpolicies (Sec. III-C): explore(room), navigate(room, object), go_to_and_<verb>(room, object).
+
+Each takes the scene graph of the current step and the names the planner used, drives the robot
+with low-level moves on the agent's own map (fusing the frames it sees on the way) and returns an
+:class:`~more_agent.sim.actions.ActionResult` whose ``feedback`` is what the planner reads next:
+a success flag plus a simple reason ("hand is full", "must open fridge A first", "no frontier left
+in kitchen_0", "unknown object"). ``go_to_and_<verb>`` drives to the Voronoi node closest to the
+object, then runs the magic action on the world object the label resolves to; that action makes
+the final approach on a circle around the object when the node is out of reach (paper S.3).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from more_agent.scene_graph import ObjectNode, SceneGraph
+from more_agent.sim import actions
+from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.sim.navgrid import XY
+
+from more_agent.planners.policies.embodiment import Embodiment
+from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
+
+MANIPULATION_SKILLS: dict[str, str] = {
+    "go_to_and_open": "open",
+    "go_to_and_close": "close",
+    "go_to_and_grasp": "grasp",
+    "go_to_and_place_inside": "place_inside",
+    "go_to_and_place_ontop": "place_ontop",
+}
+"""Skill name -> magic action verb of :data:`more_agent.sim.actions.MANIPULATIONS`."""
+
+
+def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
+    return ActionResult(ok=False, reason=reason, feedback=feedback, low_level_steps=steps)
+
+
+def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY]) -> tuple[bool, int | None, str]:
+    """Drive to the nearest reachable goal on the agent's map, replanning on the updated map when a
+    move is blocked. Returns (reached, goal index, failure feedback)."""
+    cfg = body.config
+    occupancy = graph.occupancy
+    for _ in range(cfg.max_replans + 1):
+        if occupancy is None:
+            return False, None, "no map yet"
+        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m)
+        path, index = path_to_nearest(grid, body.xy, goals, snap_m=cfg.goal_snap_m)
+        if index is None:
+            return False, None, "no path on the map"
+        if body.follow(path.waypoints):
+            return True, index, ""
+        occupancy = body.build().occupancy
+    return False, None, "the way is blocked"
+
+
+def explore(body: Embodiment, graph: SceneGraph, region_id: str, room: str) -> ActionResult:
+    """Go to the closest frontier of a region not explored before, and look around there."""
+    start = body.low_level_steps
+    near = body.config.visited_frontier_m
+    frontiers = [f for f in graph.frontiers(region_id) if all(math.dist(f, v) > near for v in body.visited_frontiers)]
+    if not frontiers:
+        return _fail(FailureReason.INVALID_TARGET, f"no frontier left in {room}")
+    reached, index, why = _drive(body, graph, frontiers)
+    if index is not None:
+        body.visited_frontiers.append(frontiers[index])
+    if not reached:
+        if index is None:  # no frontier reachable: do not offer them again
+            body.visited_frontiers.extend(frontiers)
+        return _fail(FailureReason.NOT_REACHABLE, f"cannot reach an unexplored area of {room}: {why}",
+                     body.low_level_steps - start)
+    if body.config.look_around_at_frontier:
+        body.look_around()
+    return ActionResult(ok=True, reason=None, feedback=f"explored {room}", low_level_steps=body.low_level_steps - start)
+
+
+def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionResult:
+    """Drive to the Voronoi node closest to the object on the agent's map, then face it."""
+    start = body.low_level_steps
+    if target.held:
+        return _fail(FailureReason.INVALID_TARGET, f"already holding {target.label}")
+    goal = object_goal(graph, target.id)
+    if goal is None:
+        return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: no map yet")
+    reached, _, why = _drive(body, graph, [goal])
+    if not reached:
+        return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: {why}", body.low_level_steps - start)
+    body.face(target.position[:2])
+    return ActionResult(ok=True, reason=None, feedback=f"reached {target.label}", low_level_steps=body.low_level_steps - start)
+
+
+def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode) -> ActionResult:
+    """navigate() unless the object is within reach, then the magic action on the world object."""
+    start = body.low_level_steps
+    world = body.world
+    obj = world.by_label(target.label)
+    if obj is None:
+        return _fail(FailureReason.UNKNOWN_OBJECT, f"unknown object {target.label}")
+    if not target.held and actions.distance_to_footprint(world, obj.name) > actions.REACH_M:
+        moved = navigate(body, graph, target)
+        if not moved.ok:
+            return moved
+    result = actions.go_to_and(world, verb, obj.name)
+    body.record_jump(result.path, result.low_level_steps)
+    if result.ok:
+        body.sense()  # what opening / placing revealed
+    return ActionResult(
+        ok=result.ok, reason=result.reason, feedback=result.feedback,
+        low_level_steps=body.low_level_steps - start, blocking=result.blocking,
+    )
+
+
+def pick_target(graph: SceneGraph, ids: Sequence[str], skill: str, robot_xy: XY) -> ObjectNode | None:
+    """The object a (possibly class-level) name means: among the candidates, those the skill can act
+    on by their observed state (open needs closed, close needs open), nearest to the robot first."""
+    nodes = [graph.objects[i] for i in ids if i in graph.objects]
+    want_open = {"go_to_and_open": False, "go_to_and_close": True}.get(skill)
+    suitable = [n for n in nodes if want_open is None or n.open is want_open] or nodes
+    if not suitable:
+        return None
+    return min(suitable, key=lambda n: (math.dist(n.position[:2], robot_xy), n.id))

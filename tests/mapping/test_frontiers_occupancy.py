@@ -1,0 +1,84 @@
+"""Frontier clusters and the voxel map -> BEV update."""
+
+import numpy as np
+
+from more_agent.mapping import VoxelMap, depth_to_points, frontier_points
+from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
+from tests.scene_graph.boxworld import CID, Box, camera_pose, intrinsics, render
+
+
+def test_frontier_points_one_per_long_cluster() -> None:
+    occ = np.full((60, 60), OCCUPIED, dtype=np.int8)
+    occ[5:55, 5:30] = FREE
+    occ[20:40, 30:55] = UNKNOWN  # opening of 20 cells onto unknown space
+    occ[5:7, 30] = UNKNOWN  # 2-cell crack: too short
+    pts, lengths = frontier_points(occ, resolution_m=0.1, origin_xy=(1.0, 2.0), min_length_m=0.5)
+    assert len(pts) == 1
+    assert lengths[0] >= 2.0
+    assert 1.0 + 20 * 0.1 <= pts[0, 0] <= 1.0 + 40 * 0.1 and abs(pts[0, 1] - (2.0 + 29.5 * 0.1)) < 1e-9
+
+
+def _vmap() -> VoxelMap:
+    return VoxelMap(free_class_ids=[CID["floor"], CID["lawn"]], initial_extent_m=12.0, carve_stride_px=1)
+
+
+def test_depth_to_points_inverts_projection() -> None:
+    K = intrinsics(32)
+    T = camera_pose(1.0, 2.0, 0.3)
+    boxes = [Box((-10, -10, -0.1), (10, 10, 0.0), "floor")]
+    depth, _, _ = render(boxes, K, T, 32)
+    pts, idx = depth_to_points(depth, K, T)
+    assert len(pts) == np.isfinite(depth).sum() and len(idx) == len(pts)
+    np.testing.assert_allclose(pts[:, 2], 0.0, atol=1e-4)
+
+
+def test_floor_is_free_objects_occupied_and_moved_objects_are_cleared() -> None:
+    K = intrinsics(96)
+    floor = Box((-10, -10, -0.05), (10, 10, 0.0), "floor")
+    crate = Box((2.0, -0.3, 0.0), (2.5, 0.3, 0.6), "cabinet", 7)
+    vmap = _vmap()
+    poses = [camera_pose(0, 0, yaw) for yaw in (-0.3, 0.0, 0.3)]
+    for T in poses:
+        vmap.integrate(*render([floor, crate], K, T, 96), K, T)
+    occ = vmap.occupancy()
+    cell = lambda x, y: tuple(np.floor((np.array([x, y]) - vmap.origin_xy) / 0.075).astype(int))  # noqa: E731
+    assert occ[cell(2.1, 0.0)] == OCCUPIED
+    assert occ[cell(1.0, 0.0)] == FREE
+    assert occ[cell(-3.0, 0.0)] == UNKNOWN  # behind the camera
+    assert 7 in vmap.instance_voxels()
+    for T in poses:  # the crate was taken away
+        vmap.integrate(*render([floor], K, T, 96), K, T)
+    assert vmap.occupancy()[cell(2.1, 0.0)] == FREE
+    assert 7 not in vmap.instance_voxels()
+
+
+def test_grid_grows_and_keeps_content_and_ignored_instances_are_not_mapped() -> None:
+    K = intrinsics(64)
+    floor = Box((-40, -40, -0.05), (40, 40, 0.0), "floor")
+    crate = Box((1.5, -0.3, 0.0), (2.0, 0.3, 0.6), "cabinet", 9)
+    vmap = _vmap()
+    T = camera_pose(0, 0, 0.0)
+    vmap.integrate(*render([floor, crate], K, T, 64), K, T, ignore_instances=[9])
+    assert 9 not in vmap.instance_voxels()
+    vmap.integrate(*render([floor, crate], K, T, 64), K, T)
+    shape = vmap.shape
+    T2 = camera_pose(25.0, 0, np.pi)
+    vmap.integrate(*render([floor], K, T2, 64), K, T2)
+    assert vmap.shape[0] > shape[0]
+    assert 9 in vmap.instance_voxels()
+    vmap.clear_instance(9)
+    assert 9 not in vmap.instance_voxels()
+
+
+def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
+    K = intrinsics(96)
+    floor = Box((-10, -10, -0.05), (10, 10, 0.0), "floor")
+    lintel = Box((2.0, -0.5, 2.1), (2.15, 0.5, 2.6), "door", 3)
+    pool = Box((3.0, 1.0, -0.9), (4.0, 2.0, -0.8), "table", 0)  # an obstacle below ground level
+    vmap = _vmap()
+    for yaw in (0.0, 0.4):
+        T = camera_pose(0, 0, yaw, pitch_deg=0.0)
+        vmap.integrate(*render([floor, lintel, pool], K, T, 96), K, T)
+    cell = tuple(np.floor((np.array([2.07, 0.0]) - vmap.origin_xy) / 0.075).astype(int))
+    assert vmap.occupancy()[cell] == FREE
+    assert 3 in vmap.instance_voxels()

@@ -1,0 +1,102 @@
+"""Door kernels cut regions; Eq. 1 assignment respects walls and windows."""
+
+import numpy as np
+
+from more_agent.mapping import (
+    assign_objects,
+    door_crossing_edges,
+    doorway_mask,
+    fit_door_kernel,
+    merge_subregions,
+    segment_regions,
+    sparsify,
+    voronoi_graph,
+)
+from more_agent.mapping.occupancy import FREE, OCCUPIED
+
+RES = 0.075
+
+
+def _two_rooms() -> np.ndarray:
+    """Rooms x in cells [2, 50) and [52, 100), wall rows 50..51 with a 12-cell door at y 24..36."""
+    occ = np.full((102, 62), OCCUPIED, dtype=np.int8)
+    occ[2:100, 2:60] = FREE
+    occ[50:52, :] = OCCUPIED
+    occ[50:52, 24:36] = FREE
+    return occ
+
+
+def _door_points() -> np.ndarray:
+    y = np.linspace(24, 36, 13) * RES
+    return np.stack([np.full_like(y, 51 * RES), y], 1)
+
+
+def _regions(occ: np.ndarray, doors) -> tuple:
+    g, _ = sparsify(voronoi_graph(occ, resolution_m=RES), threshold_m=1.0)
+    cut = door_crossing_edges(g, doors, threshold_m=0.15)
+    return g, cut, segment_regions(g, cut, doors)
+
+
+def test_fit_door_kernel_orientation_and_size() -> None:
+    k = fit_door_kernel(_door_points(), min_sigma_m=0.15)
+    assert abs(abs(np.cos(k.angle_rad))) < 1e-6  # width axis along y
+    assert k.sigma_along_m == np.float64(0.45).item() or abs(k.sigma_along_m - 0.45) < 1e-9
+    assert k.sigma_across_m == 0.15
+    np.testing.assert_allclose(k.center_xy, (51 * RES, 30 * RES))
+
+
+def test_observed_door_separates_two_rooms_and_unobserved_does_not() -> None:
+    occ = _two_rooms()
+    g, cut, labels = _regions(occ, [fit_door_kernel(_door_points())])
+    assert cut.sum() >= 1
+    assert labels.max() == 1
+    room = g.xy[:, 0] < 51 * RES
+    assert len(set(labels[room & (labels >= 0)])) == 1 and len(set(labels[~room & (labels >= 0)])) == 1
+    assert set(labels[room & (labels >= 0)]) != set(labels[~room & (labels >= 0)])
+    g2, cut2, labels2 = _regions(occ, [])
+    assert not cut2.any() and labels2.max() == 0
+
+
+def test_merge_subregions_joins_components_of_one_free_patch_only() -> None:
+    occ = _two_rooms()
+    door = fit_door_kernel(_door_points())
+    g, cut, labels = _regions(occ, [door])
+    # split room A's component artificially by relabelling half of it
+    room_a = labels[np.argmin(g.xy[:, 0])]
+    split = labels.copy()
+    split[(labels == room_a) & (g.xy[:, 1] > 30 * RES)] = labels.max() + 1
+    cells = np.floor(g.xy / RES).astype(int)
+    merged = merge_subregions(split, cells, occ, doorway_mask(occ.shape, [door], resolution_m=RES))
+    assert merged.max() == 1
+    np.testing.assert_array_equal(merged >= 0, labels >= 0)
+
+
+def test_object_goes_to_its_room_not_the_one_behind_the_wall() -> None:
+    occ = _two_rooms()
+    occ[44:49, 5:12] = OCCUPIED  # cabinet against the wall in room A
+    g, cut, labels = _regions(occ, [fit_door_kernel(_door_points())])
+    obj = np.array([[46.5 * RES, 8.5 * RES]])
+    vp = np.array([[25 * RES, 30 * RES]])  # robot in room A
+    label_a = labels[np.argmin(np.linalg.norm(g.xy - vp, axis=1))]
+    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=occ == OCCUPIED, resolution_m=RES)
+    assert got[0] == label_a
+    # even seen from room B, the wall keeps nodes of B out of S_O
+    vp_b = np.array([[75 * RES, 30 * RES]])
+    got_b = assign_objects(g, labels, obj, vp_b, cut=cut, blocked=occ == OCCUPIED, resolution_m=RES)
+    assert got_b[0] == label_a
+
+
+def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
+    occ = np.full((102, 62), OCCUPIED, dtype=np.int8)
+    occ[2:50, 2:60] = FREE  # house
+    occ[52:100, 2:60] = FREE  # garden, separated by a wall whose window is not passable
+    occ[44:48, 28:34] = OCCUPIED  # cabinet behind the window
+    g, cut, labels = _regions(occ, [])
+    assert labels.max() == 1
+    obj = np.array([[46 * RES, 31 * RES]])
+    vp = np.array([[56 * RES, 31 * RES]])  # garden viewpoint, 0.7 m from the wall
+    window_wall = np.zeros_like(occ, dtype=bool)
+    window_wall[50:52, :] = True
+    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=window_wall, resolution_m=RES)
+    indoor = labels[np.argmin(np.linalg.norm(g.xy - obj, axis=1) + 100 * (g.xy[:, 0] > 50 * RES))]
+    assert got[0] == indoor
