@@ -218,13 +218,15 @@ class VoxelMap:
         uniq, starts = np.unique(ids, return_index=True)
         return {int(i): p for i, p in zip(uniq, np.split(pts, starts[1:]))}
 
-    def clear_instance(self, instance_id: int) -> None:
-        """Remove every voxel of one instance (e.g. when it is picked up) and refresh the BEV."""
-        hit = self.inst == instance_id
-        if not hit.any():
-            return
+    def clear_instance(self, instance_id: int) -> np.ndarray:
+        """Remove every voxel of one instance (e.g. when it is picked up), refresh the BEV, and
+        return the world coordinates (k, 3) of the removed voxel centres."""
+        hit = (self.inst == instance_id) & (self.cls > 0)
+        ix, iy, iz = np.nonzero(hit)
         self.cls[hit] = 0
         self.inst[hit] = 0
-        cols = hit.any(axis=2)
-        xs, ys = np.nonzero(cols)
-        _update_top(self.cls, self.top_class, xs.min(), xs.max() + 1, ys.min(), ys.max() + 1, self._top_level)
+        if ix.size:
+            _update_top(self.cls, self.top_class, ix.min(), ix.max() + 1, iy.min(), iy.max() + 1, self._top_level)
+        res = self.resolution_m
+        return np.stack([self.origin_xy[0] + (ix + 0.5) * res, self.origin_xy[1] + (iy + 0.5) * res,
+                         self._z_min + (iz + 0.5) * res], axis=1)

@@ -104,6 +104,8 @@ class LLMClients:
 
     plan: LLMClient
     room: LLMClient
+    spec: str
+    """The planning LLM as a spec, e.g. 'openai:gpt-4o' (for the episode record)."""
 
 
 def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients:
@@ -116,7 +118,7 @@ def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients
         )
     rooms = room_spec(spec, config)
     plan = make_client(spec, config)
-    return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config))
+    return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config), spec=str(spec))
 
 
 @dataclass(frozen=True)
@@ -139,6 +141,8 @@ class LLMPlanner:
         self.config = config
         self.clients = clients
         self.usage = UsageMeter()
+        self.llm_seconds = 0.0
+        """Time spent waiting for LLM answers this episode (cache lookups included)."""
         self.body: Embodiment | None = None
         self.task = ""
         self.history: list[ActionRecord] = []
@@ -155,7 +159,7 @@ class LLMPlanner:
         self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
         self.task = context.instance.description
         self.history, self.feedback = [], ""
-        self.usage = UsageMeter()
+        self.usage, self.llm_seconds = UsageMeter(), 0.0
         self._reported_steps, self._reported_path = 0, 1
         self.body.sense()
         self.body.look_around()
@@ -284,6 +288,7 @@ class LLMPlanner:
     def _add(self, completions: Sequence[Completion]) -> None:
         for c in completions:
             self.usage.add(c)
+            self.llm_seconds += c.latency_s
 
     def _body(self) -> Embodiment:
         if self.body is None:

@@ -23,14 +23,24 @@ from collections import Counter
 
 from more_agent.eval.record import LLMUsage
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
-from more_agent.sim.actions import ActionResult, FailureReason, approach_rounds, go_to_and, navigate_to
+from more_agent.sim.actions import (
+    ActionResult,
+    FailureReason,
+    approach_rounds,
+    distance_to_footprint,
+    go_to_and,
+    navigate_to,
+)
 from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
-from more_agent.sim.world import World
+from more_agent.sim.world import World, WorldObject
 
 ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
 """Goal predicates the oracle knows how to achieve."""
+
+PUT_DOWN_MAX_TOP_M = 1.5
+"""Furniture taller than this (trees, wardrobes) is not used to put things down on."""
 
 MAX_FAILURES_PER_ACTION = 2
 """The oracle gives up once the same action has failed this many times."""
@@ -276,19 +286,30 @@ class OraclePlanner:
         return blocking_door(self._world, start, goals)
 
     def _put_down(self) -> HighLevelAction:
-        """Free the hand: put the held item on the floor of the room the robot is in (or the nearest other).
+        """Free the hand: put the held item down where it breaks no goal and the robot can get to.
 
-        Floors the item must not be on (a ``not ontop`` goal) are avoided.
+        In order: the floor of the robot's room, the top of the nearest furniture in that room, the
+        nearest other floor; floors the item must not be on (a ``not ontop`` goal) and spots where
+        putting down already failed are skipped.
         """
         world = self._world
         held = world.robot.held
         avoid = {lit.args[1] for lit in self._literals if lit.negated and lit.predicate == "ontop" and lit.args[0] == held}
         room = world.room_at(world.robot.x, world.robot.y)
-        floors = sorted(
-            (o for o in world.objects.values() if o.kind == "floor" and o.name not in avoid),
-            key=lambda o: (o.room != room, float(((o.center[:2] - world.robot.xy) ** 2).sum())),
+
+        def rank(o: WorldObject) -> tuple[int, float]:
+            tier = 0 if o.kind == "floor" and o.room == room else 1 if o.room == room else 2
+            return tier, distance_to_footprint(world, o.name)
+
+        spots = sorted(
+            (o for o in world.objects.values() if o.name not in avoid and (
+                o.kind == "floor" or (o.kind == "furniture" and o.room == room and o.top <= PUT_DOWN_MAX_TOP_M
+                                      and not (o.openable and not o.is_open))
+            )),
+            key=rank,
         )
-        return HighLevelAction("go_to_and_place_ontop", (floors[0].name,), note="free the hand")
+        actions = [HighLevelAction("go_to_and_place_ontop", (o.name,), note="free the hand") for o in spots]
+        return next((a for a in actions if self._failures[(a.name, a.arguments)] == 0), actions[0])
 
     # -- acting -------------------------------------------------------------------------------
     def execute(self, action: HighLevelAction) -> ActionResult:

@@ -92,7 +92,9 @@ class SceneGraphBuilder:
         for iid, info in instances.items():
             previous = self._instances.get(iid)
             if info.held and not (previous is not None and previous.held):
-                self.voxels.clear_instance(iid)
+                removed = self.voxels.clear_instance(iid)
+                if len(removed):
+                    self._set_box(iid, removed)
             self._instances[iid] = info
         held = [iid for iid, info in self._instances.items() if info.held]
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
@@ -121,7 +123,7 @@ class SceneGraphBuilder:
         )
         voxels = self.voxels.instance_voxels()
         for iid, pts in voxels.items():
-            self._boxes[iid] = (pts.min(0) - res / 2, pts.max(0) + res / 2)
+            self._set_box(iid, pts)
         doors = [fit_door_kernel(voxels[i][:, :2], min_sigma_m=cfg.door_min_sigma_m)
                  for i in sorted(voxels) if i in self._instances and self._instances[i].category == "door"]
         cut = door_crossing_edges(graph, doors, threshold_m=cfg.door_cut_threshold_m)
@@ -148,6 +150,10 @@ class SceneGraphBuilder:
                               frontier_xy, frontier_label, robot, occ, origin)
 
     # ---------------------------------------------------------------- helpers
+    def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
+        half = self.config.resolution_m / 2
+        self._boxes[iid] = (voxel_centres.min(0) - half, voxel_centres.max(0) + half)
+
     def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
         vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
         return xy if len(vps) == 0 else vps[np.argmin(np.linalg.norm(vps - xy, axis=1))]

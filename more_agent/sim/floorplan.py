@@ -118,7 +118,7 @@ def generate_floorplan(
         try:
             furniture, patches = _furnish_all(rects, items, doors, windows, rng, k)
         except _Retry as e:
-            growth[e.room] *= 1.4  # only the room that could not hold its furniture grows
+            growth = {r: g * (1.4 if r == e.room else 1.05) for r, g in growth.items()}  # mostly the failing room
             continue
         walls = _walls(runs, rects, doors, windows, wall_height_m, k)
         allx = [v for r in rects.values() for v in (r[0], r[2])]

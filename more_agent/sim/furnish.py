@@ -62,7 +62,7 @@ def furnish_room(
     *,
     driveway: Rect | None,
     k: dict,
-    attempts: int = 3,
+    attempts: int = 6,
 ) -> list[tuple[object, Vec3, Vec3]] | None:
     """Place ``items`` in the room; returns (item, centre, rotated size) per item, or None on failure."""
     m = k["t"] / 2 + _WALL_CLEAR_M

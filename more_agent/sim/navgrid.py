@@ -6,8 +6,8 @@ every wall, closed door and piece of furniture. Items are not obstacles: the pap
 non-physical steps where collisions would be unavoidable (S.2). The radius (0.2 m by default,
 smaller than Fetch's ~0.28 m base) is chosen so that 0.9 m doors and 0.8 m corridors stay passable.
 
-Grids depend only on the scene and on which doors are closed, so they are cached per (scene, closed
-doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
+Grids depend only on the world's fixed geometry and on which doors are closed, so they are cached
+per (world, closed doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
 simplified to polylines. ``blocking_door`` names the closed door on the way when a goal is only
 reachable with doors open: the magic actions report it so that a planner knows what to open.
 """
@@ -149,7 +149,7 @@ def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
     )
 
 
-_cache: OrderedDict[tuple[int, frozenset[str], NavConfig], tuple[World, NavGrid]] = OrderedDict()
+_cache: OrderedDict[tuple[int, int, frozenset[str], NavConfig], tuple[World, NavGrid]] = OrderedDict()
 
 
 def closed_doors(world: World) -> frozenset[str]:
@@ -160,12 +160,13 @@ def closed_doors(world: World) -> frozenset[str]:
 def nav_grid(world: World, config: NavConfig = DEFAULT_NAV, *, all_doors_open: bool = False) -> NavGrid:
     """The free-space raster for the world's current door states (or with every door open); cached.
 
-    Furniture never moves, so a grid only depends on the world's scene and its closed doors.
+    Furniture never moves, so a grid only depends on the world (its furniture) and its closed doors.
     """
     closed = frozenset() if all_doors_open else closed_doors(world)
-    key = (id(world.scene), closed, config)
+    n_furniture = sum(o.kind == "furniture" for o in world.objects.values())
+    key = (id(world), n_furniture, closed, config)
     hit = _cache.get(key)
-    if hit is not None and hit[0].scene is world.scene:
+    if hit is not None and hit[0] is world:
         _cache.move_to_end(key)
         return hit[1]
     grid = _build(world, closed, config)

@@ -1,0 +1,143 @@
+"""Whole builder on ray-cast box worlds: door cuts, assignment, windows, ids, reduction, export."""
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from more_agent.mapping import assign_objects, door_crossing_edges, fit_door_kernel, segment_regions, sparsify, voronoi_graph
+from more_agent.scene_graph import InstanceInfo, SceneGraph, load_scene_graph, to_networkx
+from tests.scene_graph.scenes import explore, house_and_garden, new_builder, two_rooms
+
+ROOMS = [(2.0, 2.0), (3.0, 2.0), (5.0, 2.0), (6.0, 2.0)]
+
+
+@pytest.fixture(scope="module")
+def explored():
+    boxes, infos = two_rooms()
+    builder = new_builder()
+    explore(builder, boxes, infos, ROOMS)
+    return builder, boxes, infos
+
+
+def _region_at(graph: SceneGraph, x_low: bool) -> list[str]:
+    return [r.id for r in graph.regions.values() if (r.centroid[0] < 4.0) == x_low]
+
+
+def test_observed_door_separates_the_rooms(explored) -> None:
+    builder, _, _ = explored
+    g = builder.build((2.0, 2.0))
+    assert len(g.regions) == 2
+    assert len(_region_at(g, True)) == 1 and len(_region_at(g, False)) == 1
+    assert g.robot.region_id == _region_at(g, True)[0]
+    assert g.nav.door_edges.any()
+    assert "door A" in g.objects and g.objects["door A"].category == "door"
+
+
+def test_open_door_never_observed_as_a_door_does_not_separate() -> None:
+    boxes, infos = two_rooms(door_observable=False)
+    builder = new_builder()
+    explore(builder, boxes, infos, ROOMS)
+    g = builder.build((2.0, 2.0))
+    assert len(g.regions) == 1
+    assert not g.nav.door_edges.any()
+
+
+def test_objects_go_to_the_room_they_stand_in_with_relations(explored) -> None:
+    builder, _, _ = explored
+    g = builder.build((6.0, 2.0))
+    room_a, room_b = _region_at(g, True)[0], _region_at(g, False)[0]
+    assert g.objects["cabinet A"].region_id == room_a  # against the wall shared with room B
+    assert g.objects["table A"].region_id == room_a and g.objects["apple A"].region_id == room_a
+    assert g.objects["table B"].region_id == room_b
+    assert set(g.regions[room_a].object_ids) >= {"cabinet A", "table A", "apple A"}
+    assert any(r.subject == "apple A" and r.predicate == "ontop" and r.object == "table A" for r in g.relations)
+    assert g.objects["cabinet A"].open is False and g.objects["cabinet A"].instance_id == 2
+    x = g.objects["table B"].position[0]
+    assert 6.4 < x < 7.4
+
+
+def test_region_ids_are_stable_and_room_labels_persist(explored) -> None:
+    builder, boxes, infos = explored
+    g1 = builder.build((2.0, 2.0))
+    builder.set_room_labels({_region_at(g1, True)[0]: "kitchen"})
+    explore(builder, boxes, infos, [(2.5, 1.0)], n_yaw=4)
+    g2 = builder.build((2.0, 2.0))
+    assert set(g2.regions) == set(g1.regions)
+    assert g2.regions[_region_at(g1, True)[0]].room_label == "kitchen"
+    assert g2.step == g1.step + 1
+
+
+def test_window_object_goes_indoors_and_unreachable_regions_are_dropped() -> None:
+    boxes, infos = house_and_garden()
+    builder = new_builder()
+    explore(builder, boxes, infos, [(4.7, 1.0), (4.7, 2.5), (4.6, 3.45), (6.0, 2.0)])
+    g = builder.build((6.0, 2.0))
+    garden = [r for r in g.regions.values() if r.centroid[0] > 4.1]
+    assert garden and all("cabinet A" not in r.object_ids for r in garden)
+    # Eq. 1 on the builder's own map: the cabinet, seen only from the garden, is indoors
+    cfg, vox = builder.config, builder.voxels
+    origin = tuple(vox.origin_xy)
+    graph, _ = sparsify(voronoi_graph(vox.occupancy(), resolution_m=cfg.resolution_m, origin_xy=origin), threshold_m=1.0)
+    voxels = vox.instance_voxels()
+    doors = [fit_door_kernel(voxels[1][:, :2])]
+    cut = door_crossing_edges(graph, doors)
+    labels = segment_regions(graph, cut, doors)
+    centre = voxels[2].mean(0)[None, :2]
+    blocked = np.isin(vox.top_class, builder._structure_ids)
+    got = assign_objects(graph, labels, centre, np.array([[4.7, 1.0]]), cut=cut, blocked=blocked,
+                         resolution_m=cfg.resolution_m, origin_xy=origin)
+    assert graph.xy[labels == got[0]][:, 0].max() < 4.0
+    # exploring inside makes the indoor region reachable with the cabinet in it
+    explore(builder, boxes, infos, [(2.0, 2.5), (2.0, 1.6)], n_yaw=8)
+    g2 = builder.build((6.0, 2.0))
+    rid = g2.objects["cabinet A"].region_id
+    assert rid is not None and g2.regions[rid].centroid[0] < 4.0
+
+
+def test_held_object_leaves_its_region_and_appears_in_hand(explored) -> None:
+    boxes, infos = two_rooms()
+    builder = new_builder()
+    explore(builder, boxes, infos, ROOMS[:2], n_yaw=8)
+    held = {**infos, 4: InstanceInfo(label="apple A", category="apple", held=True)}
+    explore(builder, boxes, held, [(2.0, 2.0)], n_yaw=2)
+    g = builder.build((2.0, 2.0))
+    assert g.robot.held_object == "apple A" and g.held_object is not None and g.held_object.held
+    assert g.objects["apple A"].region_id is None
+    assert all("apple A" not in r.object_ids for r in g.regions.values())
+    assert not any(r.subject == "apple A" for r in g.relations)
+
+
+def test_frontiers_point_into_unexplored_space() -> None:
+    boxes, infos = two_rooms()
+    builder = new_builder(max_range_m=2.5)
+    explore(builder, boxes, infos, [(2.0, 2.0)], n_yaw=8)
+    g = builder.build((2.0, 2.0))
+    fronts = [p for r in g.regions.values() for p in g.frontiers(r.id)]
+    assert fronts
+    assert all(g.occupancy.grid[tuple(np.floor((np.array(p) - g.occupancy.origin_xy) / 0.075).astype(int))] == 1
+               for p in fronts)
+
+
+def test_json_round_trip_networkx_and_closest_node(explored) -> None:
+    builder, _, _ = explored
+    g = builder.build((2.0, 2.0)).with_room_labels({})
+    text = g.model_dump_json()
+    back = load_scene_graph(text)
+    assert back.occupancy is None
+    assert back.model_dump() == g.model_dump()
+    np.testing.assert_array_equal(back.nav.node_xy, g.nav.node_xy)
+    with pytest.raises(ValueError):
+        load_scene_graph(text.replace('"schema_version":1', '"schema_version":99'))
+    rid = next(iter(g.regions))
+    before = g.regions[rid].room_label
+    labelled = g.with_room_labels({rid: "bathroom"})
+    assert labelled.regions[rid].room_label == "bathroom" and g.regions[rid].room_label == before
+    nxg = to_networkx(g, include_nav=True)
+    assert nxg.nodes["root"]["layer"] == "root"
+    assert all(nxg.has_edge(o.region_id, oid) for oid, o in g.objects.items())
+    assert nxg.edges["apple A", "table A"]["kind"] == "ontop"
+    assert nx.is_weakly_connected(nxg)
+    i = g.closest_node((5.9, 2.1))
+    assert np.linalg.norm(g.nav.node_xy[i] - (5.9, 2.1)) < 1.5
+    for rid in g.regions:
+        assert all(g.nav.node_region[n] == rid for n in g.regions[rid].nav_nodes)
