@@ -36,7 +36,10 @@ RING_OFFSETS_M = (0.35, 0.6, 0.9)
 """Offsets from a support's footprint edge of the fallback rings of navigation poses."""
 
 POSES_PER_RING = 32
-"""Candidate base poses sampled per circle or ring."""
+"""Candidate base poses sampled on the navigation circle."""
+
+RING_SPACING_M = 0.25
+"""Spacing of the candidate base poses along a fallback ring."""
 
 FLOOR_POSE_SPACING_M = 0.5
 """Spacing of the candidate positions inside a room when navigating to its floor."""
@@ -133,12 +136,14 @@ def _anchor(world: World, obj: WorldObject) -> WorldObject:
 
 
 def _ring(x0: float, y0: float, x1: float, y1: float, offset: float) -> list[XY]:
-    """Points at ``offset`` from a rectangle's edge, evenly spread around it."""
-    cx, cy, hx, hy = (x0 + x1) / 2, (y0 + y1) / 2, (x1 - x0) / 2 + offset, (y1 - y0) / 2 + offset
-    angles = np.linspace(0, 2 * np.pi, POSES_PER_RING, endpoint=False)
-    # Project directions onto the offset rectangle: a rounded-enough ring around elongated furniture.
-    scale = 1.0 / np.maximum(np.abs(np.cos(angles)) / hx, np.abs(np.sin(angles)) / hy)
-    return [(float(cx + s * math.cos(a)), float(cy + s * math.sin(a))) for a, s in zip(angles, scale)]
+    """Points evenly spaced (about ``RING_SPACING_M``) along a rectangle grown by ``offset``."""
+    x0, y0, x1, y1 = x0 - offset, y0 - offset, x1 + offset, y1 + offset
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    points: list[XY] = []
+    for (ax, ay), (bx, by) in zip(corners, corners[1:]):
+        n = max(1, math.ceil(math.dist((ax, ay), (bx, by)) / RING_SPACING_M))
+        points += [(ax + (bx - ax) * k / n, ay + (by - ay) * k / n) for k in range(n)]
+    return points
 
 
 def candidate_poses(world: World, name: str) -> list[list[XY]]:

@@ -92,7 +92,7 @@ def _try_furnish(inner, items, keepouts, rng, driveway, k):
     levels: list[_Obstacles] = []
     for it in items:
         if it.role == "surface":
-            got = _place_on_support(it, supports, tops, rng)
+            got = _place_on_support(inner, it, supports, tops, rng)
             if got is None:
                 got = _place_floor(inner, it, floor, rng, k["walk"], None)
             if got is None:
@@ -157,9 +157,10 @@ def _center(r: Rect, sz: float, z0: float = 0.0) -> Vec3:
     return ((r[0] + r[2]) / 2, (r[1] + r[3]) / 2, z0 + sz / 2)
 
 
-def _place_on_support(it, supports, tops: dict[int, _Obstacles], rng):
+def _place_on_support(inner, it, supports, tops: dict[int, _Obstacles], rng):
     """On top of a random support piece whose top holds the item's footprint."""
     sx, sy, sz = it.size
+    centre = ((inner[0] + inner[2]) / 2, (inner[1] + inner[3]) / 2)
     if not supports:
         return None
     for _ in range(_TRIES // 2):
@@ -170,7 +171,9 @@ def _place_on_support(it, supports, tops: dict[int, _Obstacles], rng):
             continue
         px = cx - wx / 2 + float(rng.random()) * (wx - w)
         py = cy - wy / 2 + float(rng.random()) * (wy - h)
-        edge = int(rng.integers(4))  # near one edge of the top, within the robot's reach
+        # near the edge of the top that faces the room centre, within the robot's reach
+        mids = [(cx - wx / 2, cy), (cx + wx / 2, cy), (cx, cy - wy / 2), (cx, cy + wy / 2)]
+        edge = min(range(4), key=lambda e: np.hypot(mids[e][0] - centre[0], mids[e][1] - centre[1]))
         inset = min(_EDGE_INSET_M, (wx - w) / 2 if edge < 2 else (wy - h) / 2)
         if edge < 2:
             px = cx - wx / 2 + inset if edge == 0 else cx + wx / 2 - inset - w

@@ -62,6 +62,7 @@ class Embodiment:
         self.observed: set[str] = set()
         """World object names seen so far (for the rTP metric)."""
         self.visited_frontiers: list[XY] = []
+        self._held: str | None = None
 
     @property
     def xy(self) -> XY:
@@ -69,13 +70,24 @@ class Embodiment:
         return (float(self.world.robot.x), float(self.world.robot.y))
 
     def sense(self) -> None:
-        """Render a frame from the current pose and fuse it into the scene-graph builder."""
+        """Render a frame from the current pose and fuse it into the scene-graph builder.
+
+        The robot knows what it let go of: an item released since the last frame is reported as no
+        longer held even when no camera sees it (the builder only updates instances it is told about).
+        """
         frame = self.renderer.render(self.world)
         table = instance_table(self.world, frame.instance)
         infos = {
             i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"])
             for i, d in table.items()
         }
+        released = self._held if self._held is not None and self._held != self.world.robot.held else None
+        if released is not None:
+            obj = self.world.get(released)
+            infos.setdefault(obj.instance_id, InstanceInfo(
+                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None, held=False,
+            ))
+        self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
 

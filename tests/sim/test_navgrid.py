@@ -1,0 +1,90 @@
+"""Ground-truth navigation grid: free space, inflation, door blocking, shortest paths, caching."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from more_agent.sim.navgrid import NavConfig, blocking_door, nav_grid, reachable, shortest_path
+from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall
+from more_agent.sim.world import World, WorldObject
+
+
+def two_room_scene(door_open: bool = True, door_width: float = 0.9) -> Scene:
+    """Kitchen (x 0..4.95) and living room (x 5.05..10), 4 m deep, joined by one door at (5, 2)."""
+    half = door_width / 2
+    return Scene(
+        name="two_rooms", bounds=(-0.1, -0.1, 10.1, 4.1),
+        rooms=[Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4.95, 4)),
+               Room(id="living_room_0", type="living_room", bounds=(5.05, 0, 10, 4))],
+        walls=[Wall(bounds=(-0.1, -0.1, 10.1, 0)), Wall(bounds=(-0.1, 4, 10.1, 4.1)),
+               Wall(bounds=(-0.1, 0, 0, 4)), Wall(bounds=(10, 0, 10.1, 4)),
+               Wall(bounds=(4.95, 0, 5.05, 2 - half)), Wall(bounds=(4.95, 2 + half, 5.05, 4))],
+        doors=[Door(id="door_0", rooms=("kitchen_0", "living_room_0"), center=(5, 2), width=door_width, axis="y",
+                    open=door_open)],
+        furniture=[
+            Furniture(id="fridge_0", category="fridge", room="kitchen_0", center=(0.45, 3.5, 0.9), size=(0.8, 0.8, 1.8),
+                      openable=True),
+            Furniture(id="table_0", category="table", room="living_room_0", center=(7.5, 2, 0.4), size=(1.5, 0.9, 0.8)),
+            Furniture(id="cabinet_0", category="bottom_cabinet", room="living_room_0", center=(9.6, 0.4, 0.45),
+                      size=(0.7, 0.7, 0.9), openable=True),
+        ],
+    )
+
+
+def two_room_world(door_open: bool = True) -> World:
+    """The two-room scene with an apple in the closed fridge, a bowl on the table, a box on the kitchen floor."""
+    world = World.from_scene(two_room_scene(door_open))
+    for name, size in [("apple_0", 0.08), ("bowl_0", 0.2), ("box_0", 0.3)]:
+        world.add(WorldObject(name=name, category=name[:-2], kind="item", center=np.zeros(3), size=np.full(3, size)))
+    world.place("apple_0", "fridge_0", "inside")
+    world.place("bowl_0", "table_0", "ontop")
+    world.place_on_floor_at("box_0", "floor_kitchen_0", (3.0, 3.0))
+    world.assign_labels()
+    world.set_robot_pose(2.5, 1.0, 0.0)
+    return world
+
+
+def test_free_space_excludes_walls_furniture_and_keeps_clearance():
+    grid = nav_grid(two_room_world())
+    assert grid.is_free(2.5, 1.0)
+    assert not grid.is_free(5.0, 1.0)          # wall
+    assert not grid.is_free(7.5, 2.0)          # table
+    assert not grid.is_free(7.5, 2.45 + 0.1)   # within the robot radius of the table
+    assert grid.is_free(7.5, 2.45 + 0.35)
+    assert not grid.is_free(20.0, 2.0)         # outside the scene
+
+
+def test_open_door_connects_rooms_and_closed_door_blocks():
+    world = two_room_world(door_open=True)
+    assert reachable(world, (2.5, 1.0), (8.0, 3.5))
+    world.set_open("door_0", False)
+    assert not reachable(world, (2.5, 1.0), (8.0, 3.5))
+    assert blocking_door(world, (2.5, 1.0), [(8.0, 3.5)]) == "door_0"
+    assert blocking_door(world, (2.5, 1.0), [(1.0, 1.0)]) is None
+
+
+def test_narrow_door_still_passable_with_default_radius():
+    world = World.from_scene(two_room_scene(door_width=0.6))
+    assert reachable(world, (2.5, 1.0), (8.0, 3.5))
+    assert not reachable(world, (2.5, 1.0), (8.0, 3.5), NavConfig(robot_radius_m=0.35))
+
+
+def test_shortest_path_goes_through_the_door_and_picks_nearest_goal():
+    grid = nav_grid(two_room_world())
+    path = shortest_path(grid, (2.5, 1.0), [(9.0, 3.5), (6.0, 1.0)])
+    assert path.found and path.goal_index == 1
+    assert path.waypoints[0] == (2.5, 1.0) and path.waypoints[-1] == (6.0, 1.0)
+    assert any(abs(x - 5.0) < 0.3 and abs(y - 2.0) < 0.45 for x, y in path.waypoints)  # via the doorway
+    assert 3.5 < path.length_m < 5.0
+    assert not shortest_path(grid, (2.5, 1.0), [(7.5, 2.0)]).found  # goal inside the table
+
+
+def test_grid_cached_per_door_state():
+    world = two_room_world()
+    first = nav_grid(world)
+    assert nav_grid(world) is first
+    world.set_open("door_0", False)
+    closed = nav_grid(world)
+    assert closed is not first and closed.closed_doors == frozenset({"door_0"})
+    world.set_open("door_0", True)
+    assert nav_grid(world) is first
