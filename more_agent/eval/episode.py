@@ -79,6 +79,12 @@ def run_episode(
     that cannot be instantiated in the scene) instead of recording it: the CLI turns those into
     exit status 2.
     """
+    from more_agent.planners.llm_planner import PLANNER_CONFIGS
+
+    if spec.planner in PLANNER_CONFIGS:  # LLM planners have their own loop (LLM errors, usage, traces)
+        from more_agent.planners.llm_episode import run_llm_episode
+
+        return run_llm_episode(spec, out_dir=out_dir, save_graph=save_graph, strict=strict)
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 

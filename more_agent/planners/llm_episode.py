@@ -18,6 +18,7 @@ planning text, action, feedback), and with ``save_graph`` each step's scene grap
 from __future__ import annotations
 
 import json
+import logging
 import time
 import traceback
 from pathlib import Path
@@ -32,6 +33,8 @@ from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlan
 
 if TYPE_CHECKING:
     from more_agent.sim.goals import GoalStatus
+
+log = logging.getLogger(__name__)
 
 STEPS_FILE = "steps.jsonl"
 GRAPHS_DIR = "graphs"
@@ -171,6 +174,6 @@ def _write_outputs(record: EpisodeRecord, planner: LLMPlanner | None, out: Path)
         try:
             save_trajectory_map(planner.body.world, record.trajectory, out / MAP_FILE,
                                 title=f"{record.task} ({record.scene}, {record.planner})")
-        except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record
-            record.error = record.error or f"could not draw {MAP_FILE}: {type(e).__name__}: {e}"
+        except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
+            log.warning("could not draw %s: %s: %s", out / MAP_FILE, type(e).__name__, e)
     (out / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")

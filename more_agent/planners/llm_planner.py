@@ -20,6 +20,7 @@ action whose failure is fed back to the next step, so LLM output never crashes a
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -167,7 +168,7 @@ class LLMPlanner:
     def observe(self) -> None:
         """Build the scene graph, label new regions, put it into words."""
         body = self._body()
-        graph = body.build()
+        graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         labels = self._classify_rooms(graph)
         if labels:
             body.builder.set_room_labels(labels)
@@ -192,9 +193,11 @@ class LLMPlanner:
                 max_reasks=self.config.max_reasks, purpose="plan",
             )
         except InvalidAnswer as e:
-            self._count(completions + list(e.completions), view, planning_view)
+            self._add(e.completions)
+            self.trace = StepTrace(view.text(), planning_view.text(), tuple(completions) + e.completions)
             return HighLevelAction(name=INVALID, note=e.reason)
-        self._count(completions + list(answer.completions), view, planning_view)
+        self._add(answer.completions)
+        self.trace = StepTrace(view.text(), planning_view.text(), tuple(completions) + answer.completions)
         planned = answer.value
         return HighLevelAction(name=planned.skill, arguments=planned.arguments, note=planned.reasoning)
 
@@ -257,9 +260,11 @@ class LLMPlanner:
             )
         except InvalidAnswer as e:
             completions.extend(e.completions)
+            self._add(e.completions)
             log.info("filter answer unusable, planning on the full scene: %s", e.reason)
             return view
         completions.extend(answer.completions)
+        self._add(answer.completions)
         return view.filtered(answer.value, always={view.robot_room})
 
     def _run(self, action: HighLevelAction) -> ActionResult:
@@ -281,11 +286,8 @@ class LLMPlanner:
         return go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
-    def _count(self, completions: Sequence[Completion], view: SceneView, planning_view: SceneView) -> None:
-        self._add(completions)
-        self.trace = StepTrace(scene_text=view.text(), planning_text=planning_view.text(), completions=tuple(completions))
-
     def _add(self, completions: Sequence[Completion]) -> None:
+        """Count answers in this episode's usage as soon as they arrive (an LLM error later keeps them)."""
         for c in completions:
             self.usage.add(c)
             self.llm_seconds += c.latency_s
@@ -304,6 +306,17 @@ class LLMPlanner:
         if self.view is None:
             raise RuntimeError("observe() must be called before decide() / execute()")
         return self.view
+
+
+def _without_visited_frontiers(graph: SceneGraph, visited: Sequence[tuple[float, float]], radius_m: float) -> SceneGraph:
+    """The graph without frontiers near ones already explored, so the text and explore() agree."""
+    if not visited:
+        return graph
+    regions = {
+        rid: r.model_copy(update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]})
+        for rid, r in graph.regions.items()
+    }
+    return graph.model_copy(update={"regions": regions})
 
 
 def make_more(llm: str | None) -> LLMPlanner:

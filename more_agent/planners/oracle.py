@@ -105,22 +105,27 @@ def order_literals(literals: list[Literal]) -> list[Literal]:
 
 
 def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
-    """Drop duplicates and resolve one subject with two placements through the stack they imply.
+    """Drop duplicates and resolve one subject with several placements through the stack they imply.
 
-    ``ontop(a, b)`` with ``b`` an item and ``ontop(a, c)`` (or ``inside(a, c)``) both hold when ``b``
-    goes onto (into) ``c``, since the relations follow stacks; so the second becomes ``ontop(b, c)``
-    (``inside(b, c)``). Likewise ``inside(a, b)`` and ``inside(a, c)`` become ``inside(b, c)``.
-    Placing ``a`` on ``c`` directly would undo the first literal.
+    Each subject's first placement onto / into an item is its primary one: ``ontop(a, b)`` with
+    ``b`` an item. Another ``ontop(a, c)`` (or ``inside(a, c)``) then holds once ``b`` goes onto
+    (into) ``c``, since the relations follow stacks, so it becomes ``ontop(b, c)`` (``inside(b, c)``);
+    likewise ``inside(a, b)`` with ``inside(a, c)`` becomes ``inside(b, c)``. Placing ``a`` on ``c``
+    directly would undo the primary literal.
     """
+    def placement(lit: Literal) -> bool:
+        return lit.predicate in ("inside", "ontop") and not lit.negated and lit.args[0] != ROBOT_NAME
+
+    primary: dict[str, Literal] = {}
+    for lit in literals:
+        if placement(lit) and lit.args[0] not in primary and world.get(lit.args[1]).movable:
+            primary[lit.args[0]] = lit
     out: list[Literal] = []
     for lit in literals:
-        if lit.predicate in ("inside", "ontop") and not lit.negated and lit.args[0] != ROBOT_NAME:
-            subject, target = lit.args
-            via = next((o for o in literals if not o.negated and o.args[0] == subject and o.args[1] != target
-                        and o.predicate in ("inside", "ontop") and world.get(o.args[1]).movable
-                        and (o.predicate == "ontop" or lit.predicate == "inside")), None)
-            if via is not None:
-                lit = Literal(lit.predicate, (via.args[1], target))
+        via = primary.get(lit.args[0]) if placement(lit) else None
+        if via is not None and via.args[1] != lit.args[1] and (via.predicate == "ontop" or lit.predicate == "inside"):
+            derived = Literal(lit.predicate, (via.args[1], lit.args[1]))
+            lit = derived if derived.args[0] != derived.args[1] else lit
         if lit not in out:
             out.append(lit)
     return out
@@ -245,6 +250,11 @@ class OraclePlanner:
             if held == subject:
                 return self._put_down()
             return self._put_down() if held is not None else self._fetch(subject, lit)
+        if any(d.name == target for d in world.descendants(subject)):
+            # The target rests on / in the subject: take it off first.
+            if held is not None:
+                return self._put_down()
+            return self._act("go_to_and_grasp", target, lit)
         blocker = self._blocker(target, lit.predicate)
         if held == subject:
             return self._act(f"go_to_and_place_{lit.predicate}", target, lit) if blocker is None else self._put_down()
@@ -330,7 +340,8 @@ class OraclePlanner:
                 self._observed.update(o.name for o in world.descendants(arg) if world.is_observable(o.name))
         else:
             key = (action.name, action.arguments)
-            self._failures[key] += 1
+            # A different failure (another door in the way) is progress; the same one twice is not.
+            self._failures[key] = self._failures[key] + 1 if self._last_feedback.get(key) == result.feedback else 1
             self._last_feedback[key] = result.feedback
             if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR:
                 self._door = result.blocking

@@ -3,7 +3,8 @@
 They follow the paper (S.3) and OmniGibson's symbolic primitives: grasp needs an empty hand;
 open / close need an empty hand and an openable object in the other state; placing inside needs
 the target open. Every manipulation needs the object observable (not shut inside a closed
-container) and within ``REACH_M`` of the robot base, measured to the object's footprint. Each
+container) and within ``REACH_M`` of the robot base, measured to the object's footprint (for an
+item resting in / on furniture, to that furniture's footprint). Each
 failure returns a typed ``FailureReason`` and the short feedback a planner sees ("hand is full",
 "must open fridge A first").
 
@@ -100,12 +101,19 @@ def _footprint(obj: WorldObject) -> tuple[float, float, float, float]:
     return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
 
 
+def reach_box(world: World, name: str) -> tuple[float, float, float, float]:
+    """The footprint reach is measured to: the furniture an item rests in / on, else the object's own.
+
+    Reaching into any part of a car or along a long shelf from its side is part of the magic.
+    """
+    obj = world.get(name)
+    anchor = _anchor(world, obj)
+    return _footprint(anchor if anchor.kind == "furniture" else obj)
+
+
 def distance_to_footprint(world: World, name: str) -> float:
-    """Horizontal distance from the robot base to the footprint of ``name`` (0 when above it)."""
-    x0, y0, x1, y1 = _footprint(world.get(name))
-    dx = max(x0 - world.robot.x, 0.0, world.robot.x - x1)
-    dy = max(y0 - world.robot.y, 0.0, world.robot.y - y1)
-    return math.hypot(dx, dy)
+    """Horizontal distance from the robot base to the reach footprint of ``name`` (0 when above it)."""
+    return _point_to_box((world.robot.x, world.robot.y), reach_box(world, name))
 
 
 def _check_target(world: World, name: str) -> WorldObject | ActionResult:
@@ -191,7 +199,7 @@ def count_low_level_steps(yaw: float, waypoints: list[XY], final_yaw: float) -> 
 def approach_rounds(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> list[list[XY]]:
     """Free base positions within reach of ``name``, in rounds (circle first, then support rings)."""
     grid = nav_grid(world, config)
-    box = _footprint(world.get(name))
+    box = reach_box(world, name)
     rounds = [[p for p in poses if _point_to_box(p, box) <= REACH_M and grid.is_free(*p)]
               for poses in candidate_poses(world, name)]
     return [r for r in rounds if r]

@@ -120,7 +120,7 @@ def generate_floorplan(
         except _Retry as e:
             growth = {r: g * (1.4 if r == e.room else 1.05) for r, g in growth.items()}  # mostly the failing room
             continue
-        walls = _walls(runs, rects, doors, windows, wall_height_m, k)
+        walls = _walls(runs, doors, windows, wall_height_m, k)
         allx = [v for r in rects.values() for v in (r[0], r[2])]
         ally = [v for r in rects.values() for v in (r[1], r[3])]
         pad = wall_thickness_m
@@ -342,7 +342,7 @@ def _place_windows(runs, doors, rng, k) -> list[Window]:
     return out
 
 
-def _walls(runs, rects, doors, windows, height, k) -> list[Wall]:
+def _walls(runs, doors, windows, height, k) -> list[Wall]:
     """Wall boxes along every run, with door gaps (lintel above) and window gaps (sill below, top above)."""
     out: list[Wall] = []
     t = k["t"]

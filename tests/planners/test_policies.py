@@ -1,0 +1,103 @@
+"""Subpolicies on a real (small) instantiated task: low-level motion, map growth, magic actions, feedback."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from more_agent.mapping import FREE, OCCUPIED
+from more_agent.planners.policies import Embodiment, agent_nav_grid, explore, go_to_and, navigate, path_to_nearest, pick_target
+from more_agent.scene_graph import OccupancyMap, SceneGraph
+from more_agent.sim.actions import FailureReason
+from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.scene import load_scene
+
+KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
+
+
+def fresh() -> tuple[TaskInstance, Embodiment, SceneGraph]:
+    """A kitchen task instance after the initial full turn, and its scene graph."""
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    body = Embodiment(inst.world)
+    body.look_around()
+    return inst, body, body.build()
+
+
+@pytest.fixture(scope="module")
+def looked_around() -> tuple[TaskInstance, Embodiment, SceneGraph]:
+    """``fresh()`` shared by the tests that do not move the robot."""
+    return fresh()
+
+
+def test_look_around_is_a_full_turn_of_low_level_steps(looked_around: tuple[TaskInstance, Embodiment, SceneGraph]) -> None:
+    inst, body, graph = looked_around
+    assert body.low_level_steps == 11  # 360 deg in turns of at most 35 deg
+    assert graph.objects and "fridge A" in graph.objects and "fridge_0" in body.observed
+    assert graph.robot.region_id in graph.regions
+
+
+def test_agent_grid_keeps_clear_of_obstacles_and_unknown() -> None:
+    grid = np.full((20, 10), FREE)
+    grid[10, :] = OCCUPIED
+    grid[:, 0] = 0  # unknown column
+    nav = agent_nav_grid(OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25)
+    free = nav.free.T  # back to [ix, iy]
+    assert not free[:, 0].any() and not free[8:13, :].any() and free[15, 5] and free[5, 5]
+    path, index = path_to_nearest(nav, (0.35, 0.35), [(1.55, 0.55), (0.85, 0.65)], snap_m=0.5)
+    assert index == 1 and path.found  # the nearer goal lies beyond the wall: unreachable
+    assert math.dist(path.waypoints[0], (0.35, 0.35)) < 1e-9 and math.dist(path.waypoints[-1], (0.85, 0.65)) < 0.1
+
+
+def test_navigate_drives_with_low_level_moves_and_faces_the_object() -> None:
+    inst, body, graph = fresh()
+    target = graph.objects["breakfast_table A"]
+    before, start = body.low_level_steps, body.xy
+    result = navigate(body, graph, target)
+    assert result.ok, result.feedback
+    assert result.low_level_steps == body.low_level_steps - before > 0
+    assert len(body.trajectory) > 1 and body.xy != start
+    heading = math.atan2(target.position[1] - body.xy[1], target.position[0] - body.xy[0])
+    assert abs(math.remainder(heading - inst.world.robot.yaw, 2 * math.pi)) < 0.05
+
+
+def test_go_to_and_feedback_for_failed_preconditions() -> None:
+    inst, body, graph = fresh()
+    cabinet = graph.objects["bottom_cabinet A"]
+    item = next(o for o in graph.objects.values() if o.category == "bottle_of_cooking_oil")
+    assert go_to_and(body, graph, "place_inside", cabinet).feedback == "hand is empty"
+    grasped = go_to_and(body, graph, "grasp", item)
+    assert grasped.ok, grasped.feedback
+    assert inst.world.robot.held == "bottle__of__cooking_oil_1"
+    full = go_to_and(body, graph, "open", cabinet)
+    assert not full.ok and full.reason is FailureReason.HAND_FULL and "hand is full" in full.feedback
+    closed = go_to_and(body, graph, "place_inside", cabinet)
+    assert not closed.ok and closed.feedback == "must open bottom_cabinet A first"
+    graph = body.build()
+    assert graph.robot.held_object == "bottle_of_cooking_oil A" and graph.objects["bottle_of_cooking_oil A"].held
+
+
+def test_explore_reaches_a_frontier_then_reports_none_left() -> None:
+    inst, body, graph = fresh()
+    region = graph.robot.region_id
+    assert region is not None and graph.frontiers(region)
+    first = explore(body, graph, region, "kitchen_0")
+    assert first.low_level_steps > 11 and len(body.visited_frontiers) == 1
+    for _ in range(12):
+        result = explore(body, body.build(), region, "kitchen_0")
+        if not result.ok and result.feedback == "no frontier left in kitchen_0":
+            break
+    else:
+        pytest.fail("explore never ran out of frontiers")
+    assert result.reason is FailureReason.INVALID_TARGET and result.low_level_steps == 0
+
+
+def test_pick_target_prefers_what_the_skill_can_act_on(looked_around: tuple[TaskInstance, Embodiment, SceneGraph]) -> None:
+    _, body, graph = looked_around
+    opened = graph.objects["fridge A"].model_copy(update={"id": "fridge Z", "label": "fridge Z", "open": True})
+    g = graph.model_copy(update={"objects": {**graph.objects, "fridge Z": opened}})
+    assert pick_target(g, ["fridge A", "fridge Z"], "go_to_and_close", body.xy).id == "fridge Z"
+    assert pick_target(g, ["fridge A", "fridge Z"], "go_to_and_open", body.xy).id == "fridge A"
+    assert pick_target(g, ["unicorn A"], "navigate", body.xy) is None
