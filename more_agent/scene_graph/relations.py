@@ -15,8 +15,9 @@ def spatial_relations(
 ) -> list[tuple[int, str, int]]:
     """Relations (subject index, predicate, object index) among boxes (n, 3) min / max corners.
 
-    A is inside B when at least ``inside_fraction`` of A's volume lies in B's box and B is the
-    larger box. Otherwise A is on top of B when A's bottom is within ``tol_m`` of B's top and at
+    A is inside B when at least ``inside_fraction`` of A's volume lies in B's box, A's top is
+    below B's top and B is the larger box (the top test keeps a flat item resting on a table, whose
+    voxelised box shares the table's top voxel, from reading as inside it). Otherwise A is on top of B when A's bottom is within ``tol_m`` of B's top and at
     least ``min_support_overlap`` of A's footprint lies over B's; the highest such support wins.
     """
     n = len(mins)
@@ -27,7 +28,11 @@ def spatial_relations(
     overlap = np.clip(hi - lo, 0, None)  # (A, B, 3)
     size = np.maximum(maxs - mins, 1e-9)
     vol = size.prod(1)
-    inside = (overlap.prod(2) / vol[:, None] >= inside_fraction) & (vol[:, None] < vol[None, :])
+    inside = (
+        (overlap.prod(2) / vol[:, None] >= inside_fraction)
+        & (vol[:, None] < vol[None, :])
+        & (maxs[:, None, 2] < maxs[None, :, 2] - 1e-6)
+    )
     footprint = overlap[..., 0] * overlap[..., 1] / (size[:, 0] * size[:, 1])[:, None]
     touching = np.abs(mins[:, None, 2] - maxs[None, :, 2]) <= tol_m
     ontop = (footprint >= min_support_overlap) & touching & (vol[:, None] < vol[None, :])

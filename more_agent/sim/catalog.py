@@ -159,7 +159,8 @@ SURFACE_CATEGORIES: frozenset[str] = frozenset(
     """microwave monitor printer desktop_computer coffee_maker espresso_machine blender crock_pot
     food_slicer cash_register microscope laptop standing_tv table_lamp electric_mixer shredder
     magnetic_stirrer oden_cooker popcorn_machine beer_tap drink_dispenser jam_dispenser
-    multi_station_tabletop_sink tabletop_sink drop_in_sink digital_scale projector sound_system globe""".split()
+    multi_station_tabletop_sink tabletop_sink drop_in_sink digital_scale projector sound_system globe
+    burner""".split()
 )
 """Appliances that stand on a counter, desk or table rather than on the floor."""
 

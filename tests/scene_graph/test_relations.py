@@ -14,3 +14,10 @@ def test_inside_ontop_and_none() -> None:
     assert not any(a == 4 for a, _, _ in rels)  # overhangs the cabinet by 100 %: no support
     assert not any(a in (0, 3) for a, _, _ in rels)
     assert spatial_relations(mins[:1], maxs[:1]) == []
+
+
+def test_flat_item_sharing_the_tables_top_voxel_is_ontop_not_inside():
+    # A plate on a table: after voxelisation (7.5 cm) both boxes end in the same top voxel.
+    mins = np.array([[0.0, 0.0, 0.0], [0.4, 0.4, 0.75]])
+    maxs = np.array([[1.2, 0.8, 0.825], [0.6, 0.6, 0.825]])
+    assert spatial_relations(mins, maxs) == [(1, "ontop", 0)]
