@@ -17,7 +17,7 @@ import json
 import threading
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
@@ -82,12 +82,23 @@ EXHAUSTED = Status(500, "fake server: script exhausted")
 
 
 class FakeOpenAIServer:
-    """Scripted OpenAI-compatible server on 127.0.0.1; ``default`` answers once the script is used up."""
+    """Scripted OpenAI-compatible server on 127.0.0.1.
 
-    def __init__(self, script: Iterable[ScriptItem | str] = (), *, default: ScriptItem | str = EXHAUSTED) -> None:
+    Pushed script items answer first; once they are used up, ``responder(request body)`` answers if
+    given (a scripted "brain" that reads the prompt), else ``default``.
+    """
+
+    def __init__(
+        self,
+        script: Iterable[ScriptItem | str] = (),
+        *,
+        default: ScriptItem | str = EXHAUSTED,
+        responder: Callable[[dict[str, Any]], ScriptItem | str] | None = None,
+    ) -> None:
         self._script: deque[ScriptItem] = deque()
         self.push(*script)
         self._default = Reply(default) if isinstance(default, str) else default
+        self._responder = responder
         self.requests: list[RecordedRequest] = []
         self._lock = threading.Lock()
         self._stopped = threading.Event()
@@ -112,7 +123,10 @@ class FakeOpenAIServer:
     def _next(self, request: RecordedRequest) -> ScriptItem:
         with self._lock:
             self.requests.append(request)
-            return self._script.popleft() if self._script else self._default
+            if self._script or self._responder is None:
+                return self._script.popleft() if self._script else self._default
+        answer = self._responder(request.body)
+        return Reply(answer) if isinstance(answer, str) else answer
 
     def start(self) -> FakeOpenAIServer:
         """Bind and serve in a daemon thread."""

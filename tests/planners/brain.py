@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from tests.fakes.openai_server import FakeOpenAIServer, RecordedRequest, Reply, ScriptItem
+from tests.fakes.openai_server import FakeOpenAIServer, ScriptItem
 
 _OBJECT = re.compile(r"([A-Za-z_]+(?: [A-Z]+)?)(?: \(x\d+\))?(?: \[([^\]]*)\])?")
 
@@ -23,16 +23,8 @@ class BrainServer(FakeOpenAIServer):
     """Fake OpenAI server whose answer, once the pushed script is used up, is ``brain(request body)``."""
 
     def __init__(self, brain: Callable[[dict[str, Any]], ScriptItem | str]) -> None:
-        super().__init__()
+        super().__init__(responder=brain)
         self.brain = brain
-
-    def _next(self, request: RecordedRequest) -> ScriptItem:
-        with self._lock:
-            self.requests.append(request)
-            if self._script:
-                return self._script.popleft()
-        answer = self.brain(request.body)
-        return Reply(answer) if isinstance(answer, str) else answer
 
 
 @dataclass(frozen=True)
