@@ -15,6 +15,7 @@ from typing import Any, Protocol
 
 from pydantic import BaseModel
 
+from more_agent.eval.limits import llm_limiter
 from more_agent.llm.cache import CachedAnswer, ResponseCache, request_key
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.config import CacheMode, ModelPrice
@@ -152,7 +153,8 @@ class ChatClient:
         if hit is not None:
             answer, attempts = hit, 0
         else:
-            gen = self.backend.generate(request)
+            with llm_limiter():  # one cap on concurrent calls across evaluation workers
+                gen = self.backend.generate(request)
             answer = CachedAnswer(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens)
             attempts = gen.attempts
             if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REFRESH):

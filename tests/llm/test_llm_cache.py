@@ -16,6 +16,7 @@ from more_agent.llm import (
     RoomLabelAnswer,
     make_client,
 )
+from more_agent.eval.limits import SlotContext, set_llm_limiter
 from more_agent.llm.cache import CachedAnswer
 from tests.fakes.openai_server import FakeOpenAIServer, Reply
 
@@ -104,3 +105,32 @@ def test_parallel_processes_share_the_cache(tmp_path: Path) -> None:
     assert [p.exitcode for p in procs] == [0] * 4
     cache = ResponseCache(path)
     assert len(cache) == 160 and cache.get("3-39") == CachedAnswer("t39", "m", 1, 1)
+
+
+class _CountingLimiter(SlotContext):
+    """A limiter that counts the slots taken, to see which calls go through it."""
+
+    def __init__(self) -> None:
+        self.acquired = 0
+        self.held = 0
+
+    def acquire(self) -> None:
+        self.acquired += 1
+        self.held += 1
+
+    def release(self) -> None:
+        self.held -= 1
+
+
+def test_server_calls_hold_an_evaluation_slot_and_cache_hits_do_not(
+    fake_openai: FakeOpenAIServer, llm_config: LLMConfig
+) -> None:
+    fake_openai.push(Reply('{"room": "kitchen"}'))
+    limiter = _CountingLimiter()
+    set_llm_limiter(limiter)
+    try:
+        make_client("openai:gpt-4o", llm_config).complete(MESSAGES, schema=RoomLabelAnswer)
+        make_client("openai:gpt-4o", llm_config).complete(MESSAGES, schema=RoomLabelAnswer)
+    finally:
+        set_llm_limiter(None)
+    assert (limiter.acquired, limiter.held) == (1, 0)
