@@ -1,16 +1,19 @@
 """The episode runner: instantiate a task, drive a planner step by step, check the goal, write the record.
 
 ``run_episode(spec)`` never raises for a failing episode: the reason goes into ``record.error`` (and
-``record.traceback`` when code raised). Termination follows the paper (Sec. III-D): the planner
-calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
+``record.traceback`` when code raised; an LLM error is recorded without one). Every planner, the
+oracle and the LLM planners alike, runs through this one loop. Termination follows the paper
+(Sec. III-D): the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
 ``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
 ``episode.json`` and ``map.png`` (the plan with the robot's path). Timings are seconds per phase:
-instantiate, sense, plan, act (goal checks included), write, total. Everything else in the record
+instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
+answers, part of plan) for LLM planners. Everything else in the record
 is a function of (task, scene, seed, planner, llm).
 """
 
 from __future__ import annotations
 
+import logging
 import time
 import traceback
 from collections.abc import Iterable
@@ -19,11 +22,14 @@ from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
-from more_agent.planners.base import EpisodeContext, make_planner
+from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
+    from more_agent.sim.goals import GoalChecker, GoalStatus
     from more_agent.sim.world import World
+
+log = logging.getLogger(__name__)
 
 MAX_HIGH_LEVEL_STEPS = 50
 """An episode ends after this many high-level steps (paper Sec. III-D)."""
@@ -36,9 +42,12 @@ MAP_FILE = "map.png"
 
 
 def observed_task_objects(scope: dict[str, str], world_names: Iterable[str]) -> list[str]:
-    """Scope names (e.g. 'apple.n.01_1') of the task objects among the observed world objects, sorted."""
+    """World names of the task objects among the observed world objects, sorted.
+
+    World names, like ``GoalCondition.objects``, so that rTP can match conditions to observations.
+    """
     seen = set(world_names)
-    return sorted(s for s, name in scope.items() if name in seen)
+    return sorted({name for name in scope.values() if name in seen})
 
 
 class _Clock:
@@ -72,76 +81,43 @@ def run_episode(
     save_frames: bool = False,
     save_graph: bool = False,
     strict: bool = False,
+    planner: Planner | None = None,
 ) -> EpisodeRecord:
     """Run one episode of ``spec`` and return its record (also written under ``out_dir`` when given).
 
-    ``strict`` re-raises a ``UserError`` from bad input (unknown task / scene / planner, a task
-    that cannot be instantiated in the scene) instead of recording it: the CLI turns those into
-    exit status 2.
+    ``planner`` replaces the registry's planner of ``spec.planner`` (tests inject LLM clients this
+    way). ``strict`` re-raises a ``UserError`` from bad input (unknown task / scene / planner, a
+    task that cannot be instantiated in the scene, no LLM configured) instead of recording it: the
+    CLI turns those into exit status 2. An LLM error (timeout after the retries, server gone, a
+    replay miss) ends the episode with ``record.error`` naming it, everything so far kept.
     """
-    from more_agent.planners.llm_planner import PLANNER_CONFIGS
-
-    if spec.planner in PLANNER_CONFIGS:  # LLM planners have their own loop (LLM errors, usage, traces)
-        from more_agent.planners.llm_episode import run_llm_episode
-
-        return run_llm_episode(spec, out_dir=out_dir, save_graph=save_graph, strict=strict)
+    from more_agent.llm.errors import LLMError
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
     clock = _Clock()
     record = EpisodeRecord(task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm)
     world: World | None = None
+    goals: GoalChecker | None = None
+    scope: dict[str, str] = {}
     try:
         t = time.perf_counter()
         instance = instantiate(spec.task, spec.scene, spec.seed)
-        goals = GoalChecker(instance)
-        planner = make_planner(spec.planner, spec.llm)
+        goals, scope = GoalChecker(instance), instance.scope
+        planner = planner or make_planner(spec.planner, spec.llm)
+        record.llm = planner.llm
         world = instance.world
         record.scene, record.description = instance.scene, instance.description
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=spec.llm, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph,
+            instance=instance, goals=goals, llm=planner.llm, out_dir=out_dir, save_frames=save_frames,
+            save_graph=save_graph,
         ))
-        t = clock.add("plan", t)
-        status = goals.check(world)
-        steps_since_goal = 0
-        while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
-            t = time.perf_counter()
-            planner.observe()
-            t = clock.add("sense", t)
-            action = planner.decide()
-            t = clock.add("plan", t)
-            result = planner.execute(action)
-            step = record.high_level_steps
-            record.high_level_steps += 1
-            record.low_level_steps += result.low_level_steps
-            record.actions.append(ActionRecord(
-                step=step, name=action.name, arguments=list(action.arguments), ok=result.ok,
-                feedback=result.feedback, low_level_steps=result.low_level_steps,
-            ))
-            _extend_path(record.trajectory, result.path)
-            if action.is_done:
-                record.done_called = True
-                status = goals.check(world)
-                if not status.all_met and action.note:
-                    record.error = action.note
-                clock.add("act", t)
-                break
-            status = goals.check(world)
-            clock.add("act", t)
-            steps_since_goal = steps_since_goal + 1 if status.all_met else 0
-            if steps_since_goal > STEPS_AFTER_GOAL:
-                record.error = f"all goal conditions held for {STEPS_AFTER_GOAL} steps without done()"
-                break
-        else:
-            record.error = f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
-        record.all_goals_met = status.all_met
-        record.success = status.all_met and record.done_called
-        record.task_progress = status.progress
-        record.goal_conditions = list(status.conditions)
-        record.observed_objects = observed_task_objects(instance.scope, planner.observed_objects())
-        record.llm_usage = planner.llm_usage()
+        clock.add("sense", t)
+        _run_steps(record, planner, goals, world, clock)
+    except LLMError as e:
+        record.error = f"LLM error ({type(e).__name__}): {e}"
     except UserError as e:
         if strict:
             raise
@@ -149,17 +125,62 @@ def run_episode(
     except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
         record.error = f"{type(e).__name__}: {e}"
         record.traceback = traceback.format_exc()
+    if world is not None and goals is not None and planner is not None:
+        _finish(record, goals.check(world), scope, planner)
     if out_dir is not None:
         t = time.perf_counter()
-        _write(record, world, Path(out_dir))
+        _write_map(record, world, Path(out_dir))
         clock.add("write", t)
     record.timings = clock.total()
+    if record.llm_usage.calls:
+        record.timings["llm"] = round(record.llm_usage.seconds, 6)
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return record
 
 
-def _write(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
+def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:
+    """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D)."""
+    steps_since_goal = 0
+    while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
+        t = time.perf_counter()
+        planner.observe()
+        t = clock.add("sense", t)
+        action = planner.decide()
+        t = clock.add("plan", t)
+        result = planner.execute(action)
+        status = goals.check(world)
+        clock.add("act", t)
+        record.actions.append(ActionRecord(
+            step=record.high_level_steps, name=action.name, arguments=list(action.arguments), ok=result.ok,
+            feedback=result.feedback, low_level_steps=result.low_level_steps,
+        ))
+        record.high_level_steps += 1
+        record.low_level_steps += result.low_level_steps
+        _extend_path(record.trajectory, result.path)
+        if action.is_done:
+            record.done_called = True
+            if not status.all_met and action.gave_up:
+                record.error = action.gave_up
+            return
+        steps_since_goal = steps_since_goal + 1 if status.all_met else 0
+        if steps_since_goal > STEPS_AFTER_GOAL:
+            record.error = f"all goal conditions held for {STEPS_AFTER_GOAL} steps without done()"
+            return
+    record.error = f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
+
+
+def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], planner: Planner) -> None:
+    """Goal outcome, what was observed and the LLM traffic, from the final state."""
+    record.all_goals_met = status.all_met
+    record.success = status.all_met and record.done_called
+    record.task_progress = status.progress
+    record.goal_conditions = list(status.conditions)
+    record.observed_objects = observed_task_objects(scope, planner.observed_objects())
+    record.llm_usage = planner.llm_usage()
+
+
+def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
     """The map picture (when the world was built); the record itself is written last, with final timings."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if world is None:
@@ -167,6 +188,7 @@ def _write(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
     from more_agent.viz.trajectory import save_trajectory_map
 
     try:
-        save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE, title=f"{record.task} ({record.scene})")
-    except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record
-        record.error = record.error or f"could not draw {MAP_FILE}: {type(e).__name__}: {e}"
+        save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE,
+                            title=f"{record.task} ({record.scene}, {record.planner})")
+    except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
+        log.warning("could not draw %s: %s: %s", out_dir / MAP_FILE, type(e).__name__, e)

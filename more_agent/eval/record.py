@@ -42,6 +42,7 @@ class LLMUsage(BaseModel):
     completion_tokens: int = 0
     cost_usd: float = 0.0
     cache_hits: int = 0
+    seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 
 class EpisodeRecord(BaseModel):

@@ -31,9 +31,18 @@ DEFAULT_PLANNER = "oracle"
 """The planner ``more-agent run`` uses when none is given and no LLM is configured."""
 
 
+LLM_DEFAULT_PLANNER = "more"
+"""The planner ``more-agent run`` uses when none is given and an LLM is configured."""
+
+
 def default_planner(llm: str | None) -> str:
-    """The planner to use when the user names none; the one place this default is decided."""
-    return DEFAULT_PLANNER
+    """The planner to use when the user names none; the one place this default is decided.
+
+    ``more`` when an LLM is configured (``--llm``, the environment or the config file), else the oracle.
+    """
+    from more_agent.llm import llm_configured, load_llm_config
+
+    return LLM_DEFAULT_PLANNER if llm_configured(load_llm_config(), llm) else DEFAULT_PLANNER
 
 
 @dataclass(frozen=True)
@@ -43,7 +52,9 @@ class HighLevelAction:
     name: str
     arguments: tuple[str, ...] = ()
     note: str = ""
-    """Why the planner chose it; on a ``done`` that gives up, the explanation of the failure."""
+    """Why the planner chose it (an LLM's reasoning, the oracle's goal literal)."""
+    gave_up: str = ""
+    """On a ``done`` with goals unmet on purpose: why the planner gives up (recorded as the episode's error)."""
 
     @property
     def is_done(self) -> bool:
@@ -72,6 +83,8 @@ class Planner(Protocol):
     """A high-level planner the episode runner drives step by step."""
 
     name: str
+    llm: str | None
+    """The LLM it plans with as a spec (e.g. 'openai:gpt-4o'); None for the oracle."""
 
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode."""
@@ -97,6 +110,9 @@ PlannerFactory = Callable[[str | None], Planner]
 
 _BUILTIN: dict[str, str] = {
     "oracle": "more_agent.planners.oracle:OraclePlanner",
+    "more": "more_agent.planners.llm_planner:make_more",
+    "moma-llm": "more_agent.planners.llm_planner:make_moma_llm",
+    "moma-llm-sr": "more_agent.planners.llm_planner:make_moma_llm_sr",
 }
 """Built-in planners: name -> 'module:attribute' of a factory, imported on first use."""
 

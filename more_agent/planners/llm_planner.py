@@ -14,15 +14,19 @@ and the last feedback, then run that subpolicy. Planners differ only in their
 The class implements the :class:`~more_agent.planners.base.Planner` protocol. LLM transport errors
 (timeouts, a server gone, a replay miss) propagate as :class:`~more_agent.llm.errors.LLMError` for
 the episode loop to record; an answer still invalid after the bounded re-asks becomes an ``invalid``
-action whose failure is fed back to the next step, so LLM output never crashes an episode.
+action whose failure is fed back to the next step, so LLM output never crashes an episode. With an
+output folder it appends each step's scene texts and action to ``steps.jsonl`` (and, with
+``save_graph``, the step's scene graph under ``graphs/``).
 """
 
 from __future__ import annotations
 
+import json
 import logging
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -59,6 +63,12 @@ from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 
 log = logging.getLogger(__name__)
+
+STEPS_FILE = "steps.jsonl"
+"""Per-step trace written in the episode folder: full and planning scene text, action, feedback."""
+
+GRAPHS_DIR = "graphs"
+"""Folder of per-step scene-graph JSON files (``--save-graph``)."""
 
 INVALID = "invalid"
 """Name of the action recorded when the LLM gave no usable answer after the re-asks."""
@@ -139,8 +149,11 @@ class LLMPlanner:
 
     def __init__(self, config: LLMPlannerConfig, clients: LLMClients) -> None:
         self.name = config.name
+        self.llm: str | None = clients.spec
         self.config = config
         self.clients = clients
+        self.out_dir: Path | None = None
+        self.save_graph = False
         self.usage = UsageMeter()
         self.llm_seconds = 0.0
         """Time spent waiting for LLM answers this episode (cache lookups included)."""
@@ -158,6 +171,10 @@ class LLMPlanner:
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
         self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
+        self.out_dir, self.save_graph = context.out_dir, context.save_graph
+        if self.out_dir is not None:
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+            (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
         self.task = context.instance.description
         self.history, self.feedback = [], ""
         self.usage, self.llm_seconds = UsageMeter(), 0.0
@@ -209,6 +226,8 @@ class LLMPlanner:
             step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
             feedback=result.feedback,
         ))
+        if self.out_dir is not None:
+            self._write_step(self.out_dir, self.history[-1])
         self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
         body = self._body()
         steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
@@ -222,8 +241,23 @@ class LLMPlanner:
         return set(self.body.observed) if self.body is not None else set()
 
     def llm_usage(self) -> LLMUsage:
-        """LLM traffic of this episode so far."""
-        return LLMUsage(**self.usage.totals())
+        """LLM traffic of this episode so far, with the time spent waiting for answers."""
+        return LLMUsage(**self.usage.totals(), seconds=self.llm_seconds)
+
+    def _write_step(self, out: Path, action: ActionRecord) -> None:
+        """Append the step's scene texts and action to ``steps.jsonl`` (and its graph JSON when asked)."""
+        trace = self.trace
+        line = {
+            "step": action.step, "action": action.model_dump(),
+            "scene": trace.scene_text if trace else None, "planning_scene": trace.planning_text if trace else None,
+            "robot_room": self.view.robot_room if self.view else None,
+        }
+        with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
+            f.write(json.dumps(line) + "\n")
+        if self.save_graph and self.graph is not None:
+            graphs = out / GRAPHS_DIR
+            graphs.mkdir(exist_ok=True)
+            (graphs / f"step_{action.step:03d}.json").write_text(self.graph.model_dump_json(), encoding="utf-8")
 
     # -- steps ----------------------------------------------------------------------------------
     def _classify_rooms(self, graph: SceneGraph) -> dict[str, str]:

@@ -13,8 +13,8 @@ every step and issues the next subpolicy for the first unmet literal:
 - ``ontop(robot, floor)``: ``navigate_to`` that room, at the very end.
 
 A closed door reported on the way is opened (after putting down what the hand holds). Literals
-over other predicates are skipped and named in the final ``done`` note; an action that fails twice
-makes the oracle give up with a ``done`` whose note says what failed and why.
+over other predicates are skipped and named in the final ``done``; an action that fails twice
+makes the oracle give up with a ``done`` whose ``gave_up`` says what failed and why.
 """
 
 from __future__ import annotations
@@ -146,9 +146,11 @@ class OraclePlanner:
     """Solves a task from the goal and full state through ``go_to_and_<verb>`` subpolicies."""
 
     name = "oracle"
+    llm: str | None = None
+    """The oracle plans with no LLM; the registry's ``llm`` argument is ignored."""
 
     def __init__(self, llm: str | None = None) -> None:
-        self._llm = llm
+        del llm
 
     def reset(self, context: EpisodeContext) -> None:
         """Choose the goal option and order its literals."""
@@ -196,14 +198,14 @@ class OraclePlanner:
             # bddl's ground options can be partly infeasible (e.g. '(ontop log_1 log_1)'): the next may finish the job.
             explanation = self._explain_unmet()
             if not self._adopt_next_option():
-                return HighLevelAction(DONE, note=explanation)
+                return HighLevelAction(DONE, gave_up=explanation)
             pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
             why = self._last_feedback[key]
             note = f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
-            return HighLevelAction(DONE, note=note)
+            return HighLevelAction(DONE, gave_up=note)
         return action
 
     def _explain_unmet(self) -> str:

@@ -1,13 +1,20 @@
-"""One PNG of a scene's floor plan: ground classes, walls, windows, doors (open / closed), furniture."""
+"""A scene's floor plan seen from above: ground classes, walls, windows, doors (open / closed), furniture.
+
+``draw_plan`` draws on given axes (the episode map adds items and the robot's path on top);
+``plot_plan`` writes one PNG for ``more-agent scene render``.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
 
 from more_agent.sim.scene import Scene  # noqa: E402
@@ -22,12 +29,20 @@ def _rect(b, **kw) -> Rectangle:
     return Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1], **kw)
 
 
-def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture: bool = False) -> Path:
-    """Draw ``scene`` seen from above into ``path`` (PNG) and return the path. x right, y up."""
-    path = Path(path)
-    w, h = scene.bounds[2] - scene.bounds[0], scene.bounds[3] - scene.bounds[1]
-    scale = 10.0 / max(w, h)
-    fig, ax = plt.subplots(figsize=(max(w * scale, 4) + 2.5, max(h * scale, 4)))
+def draw_plan(
+    ax: Axes,
+    scene: Scene,
+    *,
+    open_state: Mapping[str, bool] | None = None,
+    label_furniture: bool = False,
+    legend: bool = True,
+) -> None:
+    """Draw ``scene`` seen from above on ``ax`` (x right, y up).
+
+    ``open_state`` maps door / furniture ids to their current state (an episode's world); ids it
+    leaves out are drawn in the scene's initial state.
+    """
+    state = open_state or {}
     for r in scene.rooms:
         ax.add_patch(_rect(r.bounds, facecolor=GROUND_COLOURS[r.ground], edgecolor="none", zorder=0))
     for p in scene.ground_patches:
@@ -40,8 +55,8 @@ def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture
     for win in scene.windows:
         ax.add_patch(_rect(win.bounds, facecolor=_WINDOW, edgecolor="none", zorder=4))
     for d in scene.doors:
-        b = d.bounds()
-        ax.add_patch(_rect(b, facecolor=_OPEN_DOOR if d.open else _CLOSED_DOOR, edgecolor="none", zorder=4))
+        is_open = state.get(d.id, d.open)
+        ax.add_patch(_rect(d.bounds(), facecolor=_OPEN_DOOR if is_open else _CLOSED_DOOR, edgecolor="none", zorder=4))
     for f in scene.furniture:
         b = (f.center[0] - f.size[0] / 2, f.center[1] - f.size[1] / 2, f.center[0] + f.size[0] / 2, f.center[1] + f.size[1] / 2)
         ax.add_patch(_rect(b, facecolor=_OPENABLE if f.openable else _FURNITURE, edgecolor="black",
@@ -52,19 +67,36 @@ def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture
         cx, cy = (r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2
         ax.text(cx, cy, r.id, fontsize=8, ha="center", va="center", zorder=7,
                 bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.7, linewidth=0))
-    legend = [Patch(color=c, label=g) for g, c in GROUND_COLOURS.items()] + [
-        Patch(color=_WALL, label="wall"), Patch(color=_FENCE, label="fence"), Patch(color=_WINDOW, label="window"),
-        Patch(color=_OPEN_DOOR, label="open door"), Patch(color=_CLOSED_DOOR, label="closed door"),
-        Patch(color=_FURNITURE, label="furniture"), Patch(color=_OPENABLE, label="openable furniture"),
-    ]
-    ax.legend(handles=legend, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    if legend:
+        handles = [Patch(color=c, label=g) for g, c in GROUND_COLOURS.items()] + [
+            Patch(color=_WALL, label="wall"), Patch(color=_FENCE, label="fence"), Patch(color=_WINDOW, label="window"),
+            Patch(color=_OPEN_DOOR, label="open door"), Patch(color=_CLOSED_DOOR, label="closed door"),
+            Patch(color=_FURNITURE, label="furniture"), Patch(color=_OPENABLE, label="openable furniture"),
+        ]
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.set_xlim(scene.bounds[0], scene.bounds[2])
     ax.set_ylim(scene.bounds[1], scene.bounds[3])
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"{scene.name} (seed {scene.seed})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+
+
+def plan_figure(scene: Scene) -> tuple[Figure, Axes]:
+    """A figure sized to the scene's aspect ratio (about 10 inches on its long side, plus a legend)."""
+    w, h = scene.bounds[2] - scene.bounds[0], scene.bounds[3] - scene.bounds[1]
+    scale = 10.0 / max(w, h)
+    return plt.subplots(figsize=(max(w * scale, 4) + 2.5, max(h * scale, 4)))
+
+
+def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture: bool = False) -> Path:
+    """Draw ``scene`` seen from above into ``path`` (PNG) and return the path."""
+    path = Path(path)
+    fig, ax = plan_figure(scene)
+    try:
+        draw_plan(ax, scene, label_furniture=label_furniture)
+        ax.set_title(f"{scene.name} (seed {scene.seed})")
+        fig.tight_layout()
+        fig.savefig(path, dpi=dpi)
+    finally:
+        plt.close(fig)
     return path

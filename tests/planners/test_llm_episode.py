@@ -12,8 +12,9 @@ import pytest
 
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.llm import CacheMode, LLMConfig, make_client
-from more_agent.planners.llm_episode import STEPS_FILE, run_llm_episode
-from more_agent.planners.llm_planner import INVALID, LLMClients
+from more_agent.eval.episode import run_episode
+from more_agent.sim.instantiate import instantiate
+from more_agent.planners.llm_planner import INVALID, PLANNER_CONFIGS, STEPS_FILE, LLMClients, LLMPlanner
 from tests.fakes.openai_server import Close, Delay, Status
 from tests.planners.brain import BrainServer, RearrangeBrain, plan
 
@@ -49,7 +50,8 @@ def _config(server: BrainServer, tmp_path: Path, **kw: Any) -> LLMConfig:
 
 def _run(server: BrainServer, tmp_path: Path, spec: EpisodeSpec = SPEC, **kw: Any) -> EpisodeRecord:
     client = make_client("openai:fake-model", _config(server, tmp_path, **kw))
-    return run_llm_episode(spec, clients=LLMClients(client, client, "openai:fake-model"), out_dir=tmp_path / "ep")
+    planner = LLMPlanner(PLANNER_CONFIGS[spec.planner], LLMClients(client, client, "openai:fake-model"))
+    return run_episode(spec, planner=planner, out_dir=tmp_path / "ep")
 
 
 @pytest.fixture
@@ -66,7 +68,8 @@ def test_successful_episode_solves_the_task(tmp_path: Path) -> None:
     assert record.actions[-1].name == "done"
     assert record.llm_usage.calls == len(server.requests) and record.llm_usage.prompt_tokens == 100 * len(server.requests)
     assert record.low_level_steps > 11 and len(record.trajectory) > 10
-    assert "electric_refrigerator.n.01_1" in record.observed_objects
+    fridge = instantiate(SPEC.task, SPEC.scene, SPEC.seed).scope["electric_refrigerator.n.01_1"]
+    assert fridge in record.observed_objects
     steps = (tmp_path / "ep" / STEPS_FILE).read_text().splitlines()
     assert len(steps) == record.high_level_steps
     first = json.loads(steps[0])

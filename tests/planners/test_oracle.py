@@ -45,7 +45,7 @@ def solve(world: World, goals: FakeGoals, max_steps: int = 50) -> tuple[list[tup
         planner.observe()
         action = planner.decide()
         if action.is_done:
-            return log, action.note
+            return log, action.gave_up or action.note
         log.append((action.name, action.arguments, planner.execute(action).ok))
     raise AssertionError(f"no done within {max_steps} steps: {log}")
 
