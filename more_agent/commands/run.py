@@ -16,6 +16,13 @@ from rich.table import Table
 from more_agent.commands._common import console, user_errors_exit_2
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 
+NO_LLM_MESSAGE = (
+    "No LLM configured: running the privileged oracle planner. To plan with MORE, pass "
+    "--llm openai:MODEL (key in OPENAI_API_KEY, any OpenAI-compatible server in OPENAI_BASE_URL) or "
+    "--llm llamacpp:PATH.gguf, or set MORE_AGENT_LLM / a config file (see docs/llm.md)."
+)
+"""First line of ``more-agent run`` when no planner is named and no LLM is configured."""
+
 RUNS_DIR = Path("runs")
 """Parent of the default output folders."""
 
@@ -62,14 +69,22 @@ def run(
 ) -> None:
     """Run one episode of TASK and write its record and map."""
     from more_agent.eval.episode import run_episode
-    from more_agent.planners.base import default_planner, make_planner
+    from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
 
-    planner = planner or default_planner(llm)
-    make_planner(planner, llm)  # validates the name before any work
+    from more_agent.sim.tasks import load_task
+
+    load_task(task)  # an unknown task fails first, with the closest names
+    if planner is None:
+        planner = default_planner(llm)
+        if planner == DEFAULT_PLANNER:
+            console.print(NO_LLM_MESSAGE, highlight=False, soft_wrap=True)
+    agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=llm)
+    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm)
     with console.status(f"running {task} with planner {planner} ..."):
-        record = run_episode(spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True)
+        record = run_episode(
+            spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
+        )
     console.print(summary_table(record, out_dir))
     if record.traceback:
         raise typer.Exit(code=1)

@@ -4,7 +4,7 @@
 ``record.traceback`` when code raised; an LLM error is recorded without one). Every planner, the
 oracle and the LLM planners alike, runs through this one loop. Termination follows the paper
 (Sec. III-D): the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
-``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
+more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
 ``episode.json`` and ``map.png`` (the plan with the robot's path). Timings are seconds per phase:
 instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
 answers, part of plan) for LLM planners. Everything else in the record
@@ -35,7 +35,7 @@ MAX_HIGH_LEVEL_STEPS = 50
 """An episode ends after this many high-level steps (paper Sec. III-D)."""
 
 STEPS_AFTER_GOAL = 5
-"""An episode ends when the planner acts this many steps after all goal conditions hold without calling done."""
+"""An episode ends when the planner acts more than this many steps after all goal conditions hold without done()."""
 
 EPISODE_FILE = "episode.json"
 MAP_FILE = "map.png"
@@ -141,6 +141,7 @@ def run_episode(
 
 def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:
     """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D)."""
+    goal_held = goals.check(world).all_met
     steps_since_goal = 0
     while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
         t = time.perf_counter()
@@ -163,9 +164,11 @@ def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, worl
             if not status.all_met and action.gave_up:
                 record.error = action.gave_up
             return
-        steps_since_goal = steps_since_goal + 1 if status.all_met else 0
+        # Steps taken while every goal condition already held (the completing step is not one of them).
+        steps_since_goal = steps_since_goal + 1 if goal_held and status.all_met else 0
+        goal_held = status.all_met
         if steps_since_goal > STEPS_AFTER_GOAL:
-            record.error = f"all goal conditions held for {STEPS_AFTER_GOAL} steps without done()"
+            record.error = f"acted for more than {STEPS_AFTER_GOAL} steps after all goal conditions held, without done()"
             return
     record.error = f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
 

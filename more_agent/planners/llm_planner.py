@@ -61,6 +61,7 @@ from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, Policy
 from more_agent.planners.policies.skills import pick_target
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.viz.frames import FRAMES_DIR, FrameWriter
 
 log = logging.getLogger(__name__)
 
@@ -172,6 +173,8 @@ class LLMPlanner:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
         self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
         self.out_dir, self.save_graph = context.out_dir, context.save_graph
+        if context.save_frames and self.out_dir is not None:
+            self.body.on_frame = FrameWriter(self.out_dir / FRAMES_DIR, context.instance.world.class_names)
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")

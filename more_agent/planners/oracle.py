@@ -34,7 +34,9 @@ from more_agent.sim.actions import (
 from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
+from more_agent.sim.render import Renderer, instance_table
 from more_agent.sim.world import World, WorldObject
+from more_agent.viz.frames import FRAMES_DIR, FrameWriter
 
 ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
 """Goal predicates the oracle knows how to achieve."""
@@ -164,6 +166,11 @@ class OraclePlanner:
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
         self._observed: set[str] = set()
+        self._renderer = Renderer()
+        self._on_frame = (
+            FrameWriter(context.out_dir / FRAMES_DIR, self._world.class_names)
+            if context.save_frames and context.out_dir is not None else None
+        )
 
     def _adopt_next_option(self) -> bool:
         """Work on the best ground option not tried yet; False when every option has been tried."""
@@ -178,10 +185,15 @@ class OraclePlanner:
         return True
 
     def observe(self) -> None:
-        """The oracle reads the world directly: nothing to sense."""
+        """Render one frame from where the robot stands: the oracle plans from the world itself, but
+        what its camera sees is what it observed (for rTP) and what ``--save-frames`` writes."""
+        frame = self._renderer.render(self._world)
+        if self._on_frame is not None:
+            self._on_frame(frame)
+        self._observed.update(d["name"] for d in instance_table(self._world, frame.instance).values())
 
     def observed_objects(self) -> set[str]:
-        """Objects the oracle acted on, plus what it revealed by opening containers."""
+        """Objects the camera saw at each step, plus those the oracle acted on or revealed by opening."""
         return set(self._observed)
 
     def llm_usage(self) -> LLMUsage:

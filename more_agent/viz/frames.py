@@ -1,6 +1,6 @@
 """Camera frames as pictures: RGB, depth colourised, semantic colourised, written as PNG.
 
-Used by ``more-agent run ... --save-frames``. Inputs are plain arrays so that frames from the
+Used by ``more-agent run ... --save-frames`` (``FrameWriter``, under ``DIR/frames/``). Inputs are plain arrays so that frames from the
 renderer (NaN = invalid depth) and from the environment's observations (0 = invalid depth) both work.
 """
 
@@ -13,7 +13,7 @@ from matplotlib import colormaps
 from PIL import Image
 
 from more_agent.sim.camera import MAX_RANGE_M
-from more_agent.sim.render import class_colors
+from more_agent.sim.render import Frame, class_colors
 
 
 def colorize_depth(depth: np.ndarray, max_range_m: float = MAX_RANGE_M, cmap: str = "turbo") -> np.ndarray:
@@ -46,3 +46,25 @@ def save_frame(directory: str | Path, stem: str, *, rgb: np.ndarray, depth: np.n
         Image.fromarray(image).save(path)
         paths.append(path)
     return paths
+
+
+FRAMES_DIR = "frames"
+"""Folder of an episode's sensor frames (``more-agent run ... --save-frames``)."""
+
+
+class FrameWriter:
+    """Writes every frame it is given as numbered PNG triples (``frame_0000_rgb.png`` ...) into a folder.
+
+    ``class_names`` is read when a frame is written, so a world that registers new categories later
+    still gets the right semantic colours.
+    """
+
+    def __init__(self, directory: str | Path, class_names: list[str]) -> None:
+        self.directory = Path(directory)
+        self.class_names = class_names
+        self.count = 0
+
+    def __call__(self, frame: Frame) -> None:
+        save_frame(self.directory, f"frame_{self.count:04d}", rgb=frame.rgb, depth=frame.depth,
+                   semantic=frame.semantic, class_names=self.class_names)
+        self.count += 1

@@ -10,7 +10,7 @@ Perception is ground truth as in the paper (S.2): instance attributes are read f
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -19,7 +19,7 @@ from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
 from more_agent.sim.motion import full_turn_angles, move_forward, turn
 from more_agent.sim.navgrid import XY
-from more_agent.sim.render import Renderer, instance_table
+from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
 
 
@@ -62,6 +62,8 @@ class Embodiment:
         self.observed: set[str] = set()
         """World object names seen so far (for the rTP metric)."""
         self.visited_frontiers: list[XY] = []
+        self.on_frame: Callable[[Frame], None] | None = None
+        """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
 
     @property
@@ -76,6 +78,8 @@ class Embodiment:
         longer held even when no camera sees it (the builder only updates instances it is told about).
         """
         frame = self.renderer.render(self.world)
+        if self.on_frame is not None:
+            self.on_frame(frame)
         table = instance_table(self.world, frame.instance)
         infos = {
             i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"])

@@ -1,0 +1,105 @@
+"""The episode runner: determinism, termination rules, failures recorded and never raised."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.metrics import rtp
+from more_agent.planners.base import EpisodeContext, HighLevelAction
+from more_agent.sim.actions import ActionResult
+
+SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
+
+
+def _without_timings(record: EpisodeRecord) -> dict:
+    return record.model_dump(exclude={"timings"})
+
+
+def test_same_spec_gives_the_same_record_timings_aside(tmp_path: Path) -> None:
+    first = run_episode(SPEC, out_dir=tmp_path / "a")
+    second = run_episode(SPEC, out_dir=tmp_path / "b")
+    assert first.success and _without_timings(first) == _without_timings(second)
+    assert EpisodeRecord.model_validate_json((tmp_path / "a" / "episode.json").read_text()) == first
+
+
+def test_observed_objects_match_goal_condition_names_so_rtp_counts_them() -> None:
+    record = run_episode(SPEC)
+    goal_objects = {o for c in record.goal_conditions for o in c.objects}
+    assert goal_objects <= set(record.observed_objects)
+    assert rtp(record) == 1.0
+
+
+class _Idle:
+    """A planner that never finishes: it waits in place (a failing no-op) forever."""
+
+    name = "idle"
+    llm = None
+
+    def reset(self, context: EpisodeContext) -> None:
+        self.world = context.instance.world
+
+    def observe(self) -> None:
+        pass
+
+    def decide(self) -> HighLevelAction:
+        return HighLevelAction("wait")
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        return ActionResult(ok=False, reason=None, feedback="nothing happens")
+
+    def observed_objects(self) -> set[str]:
+        return set()
+
+    def llm_usage(self):  # noqa: ANN201 - protocol signature
+        from more_agent.eval.record import LLMUsage
+
+        return LLMUsage()
+
+
+def test_step_limit_ends_the_episode_with_the_reason() -> None:
+    record = run_episode(SPEC.model_copy(update={"planner": "idle"}), planner=_Idle())
+    assert record.high_level_steps == MAX_HIGH_LEVEL_STEPS and not record.done_called
+    assert record.error == f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
+
+
+class _SolveThenLinger(_Idle):
+    """Delegates to the oracle until it would call done(), then keeps waiting instead."""
+
+    def reset(self, context: EpisodeContext) -> None:
+        from more_agent.planners.oracle import OraclePlanner
+
+        self.oracle = OraclePlanner()
+        self.oracle.reset(context)
+
+    def decide(self) -> HighLevelAction:
+        action = self.oracle.decide()
+        return HighLevelAction("wait") if action.is_done else action
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        return super().execute(action) if action.name == "wait" else self.oracle.execute(action)
+
+
+def test_acting_on_after_the_goal_holds_ends_after_five_steps_without_success() -> None:
+    record = run_episode(SPEC.model_copy(update={"planner": "linger"}), planner=_SolveThenLinger())
+    assert record.all_goals_met and not record.success and not record.done_called
+    waits = [a for a in record.actions if a.name == "wait"]
+    assert len(waits) == STEPS_AFTER_GOAL + 1
+    assert "without done()" in (record.error or "")
+
+
+class _Crashing(_Idle):
+    def decide(self) -> HighLevelAction:
+        raise RuntimeError("planner bug")
+
+
+def test_a_raising_planner_is_recorded_with_its_traceback(tmp_path: Path) -> None:
+    record = run_episode(SPEC.model_copy(update={"planner": "crash"}), planner=_Crashing(), out_dir=tmp_path)
+    assert record.error == "RuntimeError: planner bug" and "Traceback" in (record.traceback or "")
+    assert (tmp_path / "episode.json").exists() and (tmp_path / "map.png").exists()
+
+
+def test_unknown_task_is_recorded_not_raised() -> None:
+    record = run_episode(SPEC.model_copy(update={"task": "no_such_task"}))
+    assert record.error is not None and "unknown task" in record.error and record.traceback is None
