@@ -32,7 +32,7 @@ import numpy as np
 from bddl.backend_abc import BDDLBackend
 from bddl.logic_base import BinaryAtomicFormula, UnaryAtomicFormula
 
-from more_agent.sim.world import World, WorldObject
+from more_agent.sim.world import World, WorldObject, floor_name
 
 NEXTTO_GAP_M = 0.3
 """Largest horizontal gap between two boxes that still counts as next to each other."""
@@ -195,7 +195,13 @@ def _predicate_arity(name: str) -> int:
 
 # -- geometry / support relations shared with instantiation ----------------------------------------
 def is_ontop(world: World, name: str, support: str) -> bool:
-    """True when ``name`` rests on ``support`` directly or through a stack of 'ontop' links."""
+    """True when ``name`` rests on ``support`` directly or through a stack of 'ontop' links.
+
+    Furniture has no support link: it stands on the floor of its room.
+    """
+    obj = world.get(name)
+    if obj.kind == "furniture":
+        return support == floor_name(obj.room)
     for parent, rel in world.ancestors(name):
         if rel != "ontop":
             return False

@@ -29,6 +29,7 @@ TASK_DATA_VERSION = 1
 
 def build_task_data(names: list[str] | None = None, progress: bool = False) -> dict[str, Any]:
     """The task data document for ``names`` (default: every activity)."""
+    from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate_in_scene
     from more_agent.sim.scenes import get_scene
 
@@ -55,6 +56,7 @@ def build_task_data(names: list[str] | None = None, progress: bool = False) -> d
             try:
                 if scene is not None:
                     inst = instantiate_in_scene(d, scene, 0)
+                    GoalChecker(inst)  # a task counts only when its goal can be scored too
                     entry["instantiable"] = True
                     entry["unsupported_init"] = inst.unsupported_literals
             except UserError as e:
@@ -66,7 +68,8 @@ def build_task_data(names: list[str] | None = None, progress: bool = False) -> d
     return {
         "version": TASK_DATA_VERSION,
         "how": "scenes: bddl knowledge-base matching of inroom requirements on combined_room_object_list.json; "
-        "instantiable: more_agent.sim.instantiate in the first suitable scene, seed 0",
+        "instantiable: more_agent.sim.instantiate in the first suitable scene, seed 0, and its goal has "
+        "a bddl ground option",
         "sets": {"more-paper": sorted(paper_tasks()), "behavior-rearrange": rearrange},
         "tasks": tasks,
     }

@@ -17,6 +17,7 @@ from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_gro
 from bddl.condition_evaluation import evaluate_state
 
 from more_agent.eval.record import GoalCondition
+from more_agent.errors import UserError
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.world import World
 
@@ -61,6 +62,10 @@ def literal_from_parsed(parsed: list[Any], scope: dict[str, ScopeObject]) -> Lit
     return Literal(predicate=atom[0], args=args, negated=negated)
 
 
+class GoalError(UserError):
+    """A task whose goal cannot be evaluated condition by condition."""
+
+
 class GoalChecker:
     """Evaluates one task instance's goal on a world (the instance's own, or another of the same task)."""
 
@@ -72,7 +77,14 @@ class GoalChecker:
         if not goal:
             raise ValueError(f"task {instance.task} has an empty goal")
         self._goal = goal
-        self._options = get_ground_goal_state_options(conds, self.backend, dict(self.scope), goal)
+        try:
+            self._options = get_ground_goal_state_options(conds, self.backend, dict(self.scope), goal)
+        except AssertionError:  # bddl asserts that it found at least one option
+            raise GoalError(
+                f"bddl finds no ground option for the goal of {instance.task} (its nested quantifiers over the "
+                "same objects have no consistent grounding within bddl's enumeration limit), so its goal "
+                "conditions cannot be scored one by one"
+            ) from None
         self._literals = [[literal_from_parsed(head.body, self.scope) for head in opt] for opt in self._options]
 
     @property

@@ -35,7 +35,7 @@ from more_agent.sim import catalog
 from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
 from more_agent.sim.scene import Scene
 from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal, load_task, scope_synset, suitable_scenes
-from more_agent.sim.world import World, WorldObject
+from more_agent.sim.world import World, WorldObject, floor_name
 
 PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
 """Init predicates that decide where an item rests, in order of preference."""
@@ -207,7 +207,7 @@ class _Builder:
                 match = self._match_room(room.id, fixed)
                 if len(match) > len(best):
                     best_room, best = room.id, match
-            best |= {s: f"floor_{best_room}" for s in ground}
+            best |= {s: floor_name(best_room) for s in ground}
             for s in ground:
                 self._bind_ground_patch(s, best_room)
             missing = [s for s in scopes if s not in best]
@@ -315,15 +315,15 @@ class _Builder:
             if pred == "inside" and support.openable and atom[2] not in opened:
                 support.is_open = False
         elif pred == "under":
-            floor = f"floor_{support.room}"
+            floor = floor_name(support.room)
             self.world.place_on_floor_at(a, floor, (float(support.center[0]), float(support.center[1])))
         elif support.parent is None or self.world.objects[support.parent].kind == "floor" or support.kind != "item":
-            self._on_free_floor(a, f"floor_{support.room}", near=support)
+            self._on_free_floor(a, floor_name(support.room), near=support)
         else:
             self.world.place(a, support.parent, support.relation or "ontop")
 
     def _default_floor(self) -> str:
-        return self.agent_floor or f"floor_{self.world.scene.rooms[0].id}"
+        return self.agent_floor or floor_name(self.world.scene.rooms[0].id)
 
     def _on_free_floor(self, name: str, floor: str, near: WorldObject | None = None,
                        area: tuple[float, float, float, float] | None = None) -> None:

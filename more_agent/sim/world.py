@@ -28,6 +28,11 @@ SLOT_GAP_M = 0.02
 """Gap left between neighbouring items on one support."""
 
 
+def floor_name(room_id: str) -> str:
+    """Name of the floor object of a room (every room has one)."""
+    return f"floor_{room_id}"
+
+
 @dataclass
 class WorldObject:
     """One object of the world. ``center`` / ``size`` describe its axis-aligned box in metres."""
@@ -100,7 +105,7 @@ class World:
         for room in scene.rooms:
             x0, y0, x1, y1 = room.bounds
             world.add(WorldObject(
-                name=f"floor_{room.id}", category=room.ground, kind="floor", room=room.id,
+                name=floor_name(room.id), category=room.ground, kind="floor", room=room.id,
                 center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, -0.005]), size=np.array([x1 - x0, y1 - y0, 0.01]),
             ))
         for door in scene.doors:

@@ -86,6 +86,24 @@ def test_ontop_follows_stacks_but_not_containers() -> None:
     assert world.is_inside("canned_food_1", "sack_1")
 
 
+def test_furniture_stands_on_its_own_rooms_floor_only() -> None:
+    from more_agent.sim.bddl_backend import is_ontop
+
+    world = _inst("putting_shopping_away").world
+    table = world.get("breakfast_table_0")
+    other_rooms = [r.id for r in world.scene.rooms if r.id != table.room]
+    assert is_ontop(world, "breakfast_table_0", f"floor_{table.room}")
+    assert other_rooms and not is_ontop(world, "breakfast_table_0", f"floor_{other_rooms[0]}")
+
+
+def test_goal_without_ground_option_is_a_clear_error() -> None:
+    from more_agent.sim.goals import GoalError
+    from more_agent.sim.instantiate import instantiate
+
+    with pytest.raises(GoalError, match="no ground option for the goal of make_a_bake_sale_stand_stall"):
+        GoalChecker(instantiate("make_a_bake_sale_stand_stall"))
+
+
 def test_check_another_world() -> None:
     inst, other = _inst("putting_shopping_away"), _inst("putting_shopping_away")
     checker = GoalChecker(inst)
