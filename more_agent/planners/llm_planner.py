@@ -16,7 +16,7 @@ The class implements the :class:`~more_agent.planners.base.Planner` protocol. LL
 the episode loop to record; an answer still invalid after the bounded re-asks becomes an ``invalid``
 action whose failure is fed back to the next step, so LLM output never crashes an episode. With an
 output folder it appends each step's scene texts and action to ``steps.jsonl`` (and, with
-``save_graph``, the step's scene graph under ``graphs/``).
+``save_graph``, the step's scene graph as JSON and PNG under ``graphs/``).
 """
 
 from __future__ import annotations
@@ -62,14 +62,12 @@ from more_agent.planners.policies.skills import pick_target
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.viz.frames import FRAMES_DIR, FrameWriter
+from more_agent.viz.graph_plot import save_step_graph
 
 log = logging.getLogger(__name__)
 
 STEPS_FILE = "steps.jsonl"
 """Per-step trace written in the episode folder: full and planning scene text, action, feedback."""
-
-GRAPHS_DIR = "graphs"
-"""Folder of per-step scene-graph JSON files (``--save-graph``)."""
 
 INVALID = "invalid"
 """Name of the action recorded when the LLM gave no usable answer after the re-asks."""
@@ -248,7 +246,7 @@ class LLMPlanner:
         return LLMUsage(**self.usage.totals(), seconds=self.llm_seconds)
 
     def _write_step(self, out: Path, action: ActionRecord) -> None:
-        """Append the step's scene texts and action to ``steps.jsonl`` (and its graph JSON when asked)."""
+        """Append the step's scene texts and action to ``steps.jsonl`` (and its graph, JSON + PNG, when asked)."""
         trace = self.trace
         line = {
             "step": action.step, "action": action.model_dump(),
@@ -258,9 +256,7 @@ class LLMPlanner:
         with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
             f.write(json.dumps(line) + "\n")
         if self.save_graph and self.graph is not None:
-            graphs = out / GRAPHS_DIR
-            graphs.mkdir(exist_ok=True)
-            (graphs / f"step_{action.step:03d}.json").write_text(self.graph.model_dump_json(), encoding="utf-8")
+            save_step_graph(out, action.step, self.graph)
 
     # -- steps ----------------------------------------------------------------------------------
     def _classify_rooms(self, graph: SceneGraph) -> dict[str, str]:

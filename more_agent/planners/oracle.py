@@ -20,9 +20,11 @@ makes the oracle give up with a ``done`` whose ``gave_up`` says what failed and 
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import replace
 
 from more_agent.eval.record import LLMUsage
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.policies import Embodiment
 from more_agent.sim.actions import (
     ActionResult,
     FailureReason,
@@ -34,9 +36,9 @@ from more_agent.sim.actions import (
 from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
-from more_agent.sim.render import Renderer, instance_table
 from more_agent.sim.world import World, WorldObject
 from more_agent.viz.frames import FRAMES_DIR, FrameWriter
+from more_agent.viz.graph_plot import save_step_graph
 
 ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
 """Goal predicates the oracle knows how to achieve."""
@@ -166,11 +168,13 @@ class OraclePlanner:
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
         self._observed: set[str] = set()
-        self._renderer = Renderer()
-        self._on_frame = (
-            FrameWriter(context.out_dir / FRAMES_DIR, self._world.class_names)
-            if context.save_frames and context.out_dir is not None else None
-        )
+        self._body = Embodiment(self._world)
+        if context.save_frames and context.out_dir is not None:
+            self._body.on_frame = FrameWriter(context.out_dir / FRAMES_DIR, self._world.class_names)
+        self._graph_dir = context.out_dir if context.save_graph else None
+        self._steps = 0
+        self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)
+        self._turn_steps = self._body.low_level_steps
 
     def _adopt_next_option(self) -> bool:
         """Work on the best ground option not tried yet; False when every option has been tried."""
@@ -185,16 +189,17 @@ class OraclePlanner:
         return True
 
     def observe(self) -> None:
-        """Render one frame from where the robot stands: the oracle plans from the world itself, but
-        what its camera sees is what it observed (for rTP) and what ``--save-frames`` writes."""
-        frame = self._renderer.render(self._world)
-        if self._on_frame is not None:
-            self._on_frame(frame)
-        self._observed.update(d["name"] for d in instance_table(self._world, frame.instance).values())
+        """Sense one frame from where the robot stands. The oracle plans from the world itself, but what
+        its camera sees is what it observed (for rTP), what ``--save-frames`` writes and what the
+        ``--save-graph`` scene graph is built from."""
+        self._body.sense()
+        if self._graph_dir is not None:
+            save_step_graph(self._graph_dir, self._steps, self._body.build())
+        self._steps += 1
 
     def observed_objects(self) -> set[str]:
         """Objects the camera saw at each step, plus those the oracle acted on or revealed by opening."""
-        return set(self._observed)
+        return self._observed | self._body.observed
 
     def llm_usage(self) -> LLMUsage:
         """The oracle uses no LLM."""
@@ -337,6 +342,13 @@ class OraclePlanner:
 
     # -- acting -------------------------------------------------------------------------------
     def execute(self, action: HighLevelAction) -> ActionResult:
+        """Run a subpolicy through the magic actions; the first result also counts the initial full turn."""
+        result = self._run(action)
+        if self._turn_steps:
+            result, self._turn_steps = replace(result, low_level_steps=result.low_level_steps + self._turn_steps), 0
+        return result
+
+    def _run(self, action: HighLevelAction) -> ActionResult:
         """Run a subpolicy through the magic actions; remember failures and blocking doors."""
         world = self._world
         if action.name == DONE:

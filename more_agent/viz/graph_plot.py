@@ -28,6 +28,12 @@ def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None =
         x0, y0 = occ.origin_xy
         extent = (x0, x0 + nx_ * occ.resolution_m, y0, y0 + ny_ * occ.resolution_m)
         ax.imshow(occ.grid.T, origin="lower", extent=extent, cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest")
+        known = np.argwhere(occ.grid != 0)
+        if len(known):  # show the explored part, with a metre around it
+            lo = known.min(0) * occ.resolution_m + np.asarray(occ.origin_xy) - 1.0
+            hi = (known.max(0) + 1) * occ.resolution_m + np.asarray(occ.origin_xy) + 1.0
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
     colours = plt.get_cmap("tab10")
     region_colour = {rid: colours(i % 10) for i, rid in enumerate(sorted(graph.regions))}
     xy = graph.nav.node_xy
@@ -62,3 +68,15 @@ def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None =
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
+
+
+GRAPHS_DIR = "graphs"
+"""Folder of an episode's per-step scene graphs (``more-agent run ... --save-graph``)."""
+
+
+def save_step_graph(out_dir: str | Path, step: int, graph: SceneGraph) -> Path:
+    """Write one step's scene graph as ``graphs/step_NNN.json`` and its picture ``graphs/step_NNN.png``."""
+    graphs = Path(out_dir) / GRAPHS_DIR
+    graphs.mkdir(parents=True, exist_ok=True)
+    (graphs / f"step_{step:03d}.json").write_text(graph.model_dump_json(), encoding="utf-8")
+    return plot_scene_graph(graph, graphs / f"step_{step:03d}.png", title=f"step {step}")
