@@ -9,8 +9,10 @@ What is drawn (docs/sensors.md):
 - room ground as its thin floor slab (semantic = the room's ground class, instance 0);
 - walls with their z ranges (class "wall", instance 0); windows are the gaps between wall pieces,
   see-through and unlabelled;
-- per door a lintel above the opening (class "door", the door's instance id), plus the leaf filling
-  the opening while the door is closed; open leaves are not drawn;
+- per door its frame, a lintel above the opening and a jamb on each side of it (class "door", the
+  door's instance id), plus the leaf filling the opening while the door is closed; open leaves are
+  not drawn. The jambs make an open doorway recognisable from close by, where the lintel is above
+  the camera's field of view;
 - furniture and items as boxes with their category and instance id; items only while
   ``world.is_observable`` (not held, not inside a closed container). An open container, or a
   non-openable one with something inside, is a cage: bottom and top slabs of
@@ -37,6 +39,9 @@ GRID_CELL_M = 1.0
 
 CAGE_POST_M = 0.03
 """Side of the corner posts of an open container's cage (at most 15% of its footprint)."""
+
+DOOR_JAMB_M = 0.05
+"""Width of a door frame's jambs, inside the opening on each side."""
 
 DOOR_INSET_M = 0.002
 """How far door boxes stand proud of their wall on each side (so the door wins ties with the wall)."""
@@ -124,9 +129,9 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
 
 
 def _door_boxes(world: World, door: WorldObject) -> list[tuple[np.ndarray, np.ndarray, int, int]]:
-    """The lintel above a door's opening, and its leaf while closed.
+    """A door's frame (lintel above the opening, a jamb on each side) and its leaf while closed.
 
-    Both are thickened by ``DOOR_INSET_M`` across the wall so that they, not the wall piece that
+    All are thickened by ``DOOR_INSET_M`` across the wall so that they, not the wall piece that
     may share the lintel's box, are what the camera sees (doors are listed first, too).
     """
     lo, hi = door.box()
@@ -137,6 +142,11 @@ def _door_boxes(world: World, door: WorldObject) -> list[tuple[np.ndarray, np.nd
     out = []
     if top > hi[2]:
         out.append((np.array([lo[0], lo[1], hi[2]]), np.array([hi[0], hi[1], top]), sem, door.instance_id))
+    along = 1 - across
+    for start in (lo[along], hi[along] - DOOR_JAMB_M):
+        jamb_lo, jamb_hi = lo.copy(), hi.copy()
+        jamb_lo[along], jamb_hi[along] = start, start + DOOR_JAMB_M
+        out.append((jamb_lo, jamb_hi, sem, door.instance_id))
     if not door.is_open:
         out.append((lo, hi, sem, door.instance_id))
     return out

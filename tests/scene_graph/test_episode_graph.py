@@ -1,0 +1,41 @@
+"""A whole episode's scene graph, built from rendered frames, matches the world's rooms.
+
+The robot visits every room of a generated BEHAVIOR-1K plan (Rs_int, all doors open) and turns
+once in place in each; the graph built from those frames must have one region per room, every
+Voronoi node of a region inside that room, and every observed object in the region of its room.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from more_agent.planners.policies import Embodiment
+from more_agent.sim.navgrid import nav_grid
+from more_agent.sim.scenes import get_scene
+from more_agent.sim.world import World
+
+
+def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> None:
+    world = World.from_scene(get_scene("Rs_int", 0))
+    for door in world.scene.doors:
+        world.set_open(door.id, True)
+    grid = nav_grid(world)
+    body = Embodiment(world)
+    for room in world.scene.rooms:
+        x0, y0, x1, y1 = room.bounds
+        world.set_robot_pose(*grid.to_xy(*grid.snap((x0 + x1) / 2, (y0 + y1) / 2)), 0.0)
+        body.look_around()
+    graph = body.build()
+
+    region_room = {}
+    for rid, region in graph.regions.items():
+        rooms = Counter(world.room_at(*graph.nav.node_xy[i]) for i in region.nav_nodes)
+        assert len(rooms) == 1, f"{rid} spans {dict(rooms)}"
+        region_room[rid] = next(iter(rooms))
+    assert sorted(region_room.values()) == sorted(r.id for r in world.scene.rooms)
+
+    by_label = {o.label: o for o in world.objects.values()}
+    placed = [o for o in graph.objects.values() if o.category != "door" and o.region_id is not None]
+    assert len(placed) >= 20
+    for obj in placed:
+        assert region_room[obj.region_id] == by_label[obj.label].room, obj.label
