@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 
 from more_agent.cli import app
 from more_agent.commands.run import NO_LLM_MESSAGE
+from more_agent.sim.motion import full_turn_angles
 
 runner = CliRunner()
 TASK = "putting_shopping_away"
@@ -33,7 +34,7 @@ def test_default_run_without_llm_says_so_first_and_solves_with_the_oracle(tmp_pa
     assert {"task", "seed", "high_level_steps", "low_level_steps", "actions", "llm_usage", "timings"} <= set(record)
     assert (tmp_path / "map.png").stat().st_size > 10_000
     frames = sorted((tmp_path / "frames").glob("frame_*_rgb.png"))
-    assert len(frames) == record["high_level_steps"]
+    assert len(frames) == len(full_turn_angles()) + record["high_level_steps"]  # the initial turn, then one a step
 
 
 @pytest.mark.parametrize(
