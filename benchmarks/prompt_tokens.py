@@ -5,7 +5,9 @@ high-level steps driven by an in-process scripted LLM (no network): rooms are la
 rule, the filter keeps the objects of the task's categories (an ideal filter's answer), and the
 plan explores the rooms with unexplored areas in turn. On every recorded state the planning prompt
 is rendered twice, once with the full scene text (no filtering, as MoMa-LLM) and once with the
-filtered text (MORE), so both sizes come from the same states.
+filtered text (MORE), so both sizes come from the same states. Unless ``--keep-doors`` is given,
+every door is opened at the start: the scripted explorer never opens doors, and the point is to
+see the prompt grow as the explored part of a large scene does.
 
 Tokens are estimated (no tokenizer is installed here): one token per word or punctuation mark,
 a rough stand-in for tiktoken's counts; the scene text alone is reported too, as the
@@ -14,7 +16,7 @@ prompt's fixed part (instructions, skill API) does not change with filtering.
 labels, language, filtering, parsing) on one core; ``act_s`` is the subpolicy's time (motion,
 rendering and fusing frames).
 
-    python benchmarks/prompt_tokens.py [--scenes house_single_floor Beechwood_0_garden ...] [--steps 12]
+    python benchmarks/prompt_tokens.py [--scenes house_single_floor Beechwood_0_garden ...] [--steps 30] [--keep-doors]
 """
 
 from __future__ import annotations
@@ -110,12 +112,15 @@ def pick_task(scene: str) -> str | None:
     return next((t for t in task_set("more-paper") if scene in suitable_scenes(t)), None)
 
 
-def run_scene(scene: str, steps: int, seed: int) -> dict[str, object]:
+def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True) -> dict[str, object]:
     """Record ``steps`` planning steps in one scene; sizes and times per step, summarised."""
     task = pick_task(scene)
     if task is None:
         return {"scene": scene, "error": "no paper task suits this scene"}
     instance = instantiate(task, scene, seed)
+    if open_doors:
+        for door in instance.world.scene.doors:
+            instance.world.set_open(door.id, True)
     categories = {instance.world.get(n).category for n in instance.scope.values() if n in instance.world.objects}
     llm = ScriptedLLM(categories)
     planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(llm, llm, "scripted"))
@@ -159,11 +164,12 @@ def run_scene(scene: str, steps: int, seed: int) -> dict[str, object]:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--scenes", nargs="+", default=list(DEFAULT_SCENES))
-    parser.add_argument("--steps", type=int, default=12)
+    parser.add_argument("--steps", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--keep-doors", action="store_true", help="leave doors as generated (some closed)")
     args = parser.parse_args(argv)
     for scene in args.scenes:
-        print(json.dumps(run_scene(scene, args.steps, args.seed)), flush=True)
+        print(json.dumps(run_scene(scene, args.steps, args.seed, open_doors=not args.keep_doors)), flush=True)
     return 0
 
 
