@@ -1,14 +1,10 @@
 """Voronoi graph: nodes on free cells with clearance, metric edges, passes doors."""
 
-import sys
-from pathlib import Path
-
 import numpy as np
 
 from more_agent.mapping import voronoi_graph
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks"))
 
 
 def _cells(xy: np.ndarray, origin, res: float) -> np.ndarray:
@@ -38,11 +34,17 @@ def test_empty_and_obstacle_only_maps_give_empty_graphs() -> None:
     assert voronoi_graph(np.full((20, 20), OCCUPIED, np.int8), resolution_m=0.1).n_nodes == 0
 
 
-def test_synthetic_apartment_graph_is_connected() -> None:
-    from synth_apartment import make_apartment
+def test_generated_apartment_graph_is_connected() -> None:
+    from more_agent.sim.navgrid import nav_grid
+    from more_agent.sim.scenes import get_scene
+    from more_agent.sim.world import World
 
-    occ, *_ = make_apartment(N=300)
-    g = voronoi_graph(occ.astype(np.int8), resolution_m=0.075)
+    world = World.from_scene(get_scene("Rs_int", 0))
+    for door in world.scene.doors:
+        world.set_open(door.id, True)
+    free = nav_grid(world).free.T  # navgrid rows are y; occupancy grids index (x, y)
+    occ = np.where(free, FREE, OCCUPIED).astype(np.int8)
+    g = voronoi_graph(occ, resolution_m=0.075)
     assert g.n_nodes > 100
     comps = np.bincount(g.components())
     assert comps.max() > 0.95 * g.n_nodes
