@@ -1,0 +1,35 @@
+"""The episode record contract of an oracle episode: fields, files, strict bad input (runner rules: test_episode_runner)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from more_agent.errors import UserError
+from more_agent.eval.episode import run_episode
+from more_agent.eval.record import EpisodeSpec
+from more_agent.planners.base import DONE
+
+SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
+
+
+def test_oracle_episode_record_fields_and_files(tmp_path):
+    record = run_episode(SPEC, out_dir=tmp_path)
+    assert record.success and record.all_goals_met and record.done_called and record.error is None
+    assert record.task_progress == 1.0 and record.goal_conditions and all(c.satisfied for c in record.goal_conditions)
+    assert record.actions[-1].name == DONE and record.high_level_steps == len(record.actions)
+    assert all(a.ok for a in record.actions) and all(a.feedback for a in record.actions)
+    assert record.low_level_steps == sum(a.low_level_steps for a in record.actions) > 0
+    assert len(record.trajectory) > 2 and record.llm is None and record.llm_usage.calls == 0
+    assert set(record.timings) >= {"instantiate", "plan", "act", "sense", "total"}
+    saved = json.loads((tmp_path / "episode.json").read_text())
+    assert saved["success"] is True and saved["task"] == SPEC.task and saved["scene"] == "Rs_int"
+    assert (tmp_path / "map.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_strict_raises_bad_input_instead_of_recording_it():
+    with pytest.raises(UserError, match="closest"):
+        run_episode(SPEC.model_copy(update={"planner": "oracel"}), strict=True)
+    record = run_episode(SPEC.model_copy(update={"scene": "Rs_itn"}))
+    assert not record.success and "closest: Rs_int" in (record.error or "") and record.traceback is None
