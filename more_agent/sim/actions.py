@@ -96,11 +96,6 @@ def _label(obj: WorldObject) -> str:
     return obj.label or obj.name
 
 
-def _footprint(obj: WorldObject) -> tuple[float, float, float, float]:
-    lo, hi = obj.box()
-    return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
-
-
 def reach_box(world: World, name: str) -> tuple[float, float, float, float]:
     """The footprint reach is measured to: the furniture an item rests in / on, else the object's own.
 
@@ -108,7 +103,7 @@ def reach_box(world: World, name: str) -> tuple[float, float, float, float]:
     """
     obj = world.get(name)
     anchor = _anchor(world, obj)
-    return _footprint(anchor if anchor.kind == "furniture" else obj)
+    return (anchor if anchor.kind == "furniture" else obj).footprint()
 
 
 def distance_to_footprint(world: World, name: str) -> float:
@@ -160,7 +155,7 @@ def candidate_poses(world: World, name: str) -> list[list[XY]]:
     For a floor (going to a room) the positions are a grid over the room instead.
     """
     obj = world.get(name)
-    x0, y0, x1, y1 = _footprint(obj)
+    x0, y0, x1, y1 = obj.footprint()
     if obj.kind == "floor":
         xs, ys = np.arange(x0 + 0.25, x1, FLOOR_POSE_SPACING_M), np.arange(y0 + 0.25, y1, FLOOR_POSE_SPACING_M)
         return [[(float(x), float(y)) for y in ys for x in xs]]
@@ -170,7 +165,7 @@ def candidate_poses(world: World, name: str) -> list[list[XY]]:
     rounds = [[(float(cx + radius * math.cos(a)), float(cy + radius * math.sin(a))) for a in angles]]
     anchor = _anchor(world, obj)
     if anchor.kind != "floor":
-        rounds += [_ring(*_footprint(anchor), offset) for offset in RING_OFFSETS_M]
+        rounds += [_ring(*anchor.footprint(), offset) for offset in RING_OFFSETS_M]
     return rounds
 
 
@@ -219,7 +214,7 @@ def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> Act
         return _fail(FailureReason.INVALID_TARGET, f"already holding {_label(obj)}")
     grid = nav_grid(world, config)
     start = (world.robot.x, world.robot.y)
-    x0, y0, x1, y1 = _footprint(obj)
+    x0, y0, x1, y1 = obj.footprint()
     center = ((x0 + x1) / 2, (y0 + y1) / 2)
     rounds = approach_rounds(world, name, config)
     for poses in rounds:
@@ -291,7 +286,6 @@ def grasp(world: World, name: str) -> ActionResult:
     if far is not None:
         return far
     world.pick(name)
-    world.set_robot_pose(world.robot.x, world.robot.y, world.robot.yaw)  # the item moves to the gripper
     return _ok(f"grasped {_label(obj)}")
 
 
@@ -315,8 +309,7 @@ def _place(world: World, name: str, relation: str) -> ActionResult:
         return far
     if target.kind == "floor":
         ahead = (world.robot.x + 0.4 * math.cos(world.robot.yaw), world.robot.y + 0.4 * math.sin(world.robot.yaw))
-        fx0, fy0, fx1, fy1 = _footprint(target)
-        world.place(held, name, "ontop")
+        fx0, fy0, fx1, fy1 = target.footprint()
         world.place_on_floor_at(held, name, (min(max(ahead[0], fx0), fx1), min(max(ahead[1], fy0), fy1)))
     else:
         world.place(held, name, relation)  # type: ignore[arg-type]

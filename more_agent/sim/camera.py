@@ -51,11 +51,6 @@ class Camera:
         """Focal length in pixels (square pixels: fx = fy)."""
         return (self.width / 2) / math.tan(math.radians(self.hfov_deg) / 2)
 
-    @property
-    def vfov_deg(self) -> float:
-        """Vertical field of view implied by the horizontal one and the aspect ratio."""
-        return math.degrees(2 * math.atan((self.height / 2) / self.focal_px))
-
     def intrinsics(self) -> np.ndarray:
         """The 3x3 intrinsic matrix K (float64)."""
         f = self.focal_px

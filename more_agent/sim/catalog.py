@@ -32,19 +32,23 @@ def _room_lists() -> dict[str, dict[str, dict[str, int]]]:
 
 
 @cache
-def _model_sizes() -> dict[str, Vec3]:
+def _inventory() -> dict:
+    """``object_inventory.json`` (3 MB), read once."""
     with open(os.path.join(_data_dir(), "object_inventory.json")) as f:
-        raw = json.load(f)["bounding_box_sizes"]
+        return json.load(f)
+
+
+@cache
+def _model_sizes() -> dict[str, Vec3]:
+    raw = _inventory()["bounding_box_sizes"]
     return {model: (float(s[0]), float(s[1]), float(s[2])) for model, s in raw.items()}
 
 
 @cache
 def _category_models() -> dict[str, list[str]]:
     """Category -> model ids, from the inventory's 'providers' keys ('category-model')."""
-    with open(os.path.join(_data_dir(), "object_inventory.json")) as f:
-        providers = json.load(f)["providers"]
     out: dict[str, list[str]] = {}
-    for key in providers:
+    for key in _inventory()["providers"]:
         category, model = key.rsplit("-", 1)
         out.setdefault(category, []).append(model)
     return out
@@ -181,6 +185,9 @@ FREE_STANDING_CATEGORIES: frozenset[str] = frozenset(
     serving_cart dish_rack_cart cubicle hammam_bench stadium_stand bicycle boulder""".split()
 )
 """Floor furniture placed away from walls; every other floor piece goes against a wall first."""
+
+VEHICLE_CATEGORIES: frozenset[str] = frozenset({"car", "recreational_vehicle", "motorcycle"})
+"""Free-standing pieces that go on a garden's driveway (which the generator adds for them)."""
 
 ROLE_CAPS: dict[str, int] = {"tree": 4, "bush": 8, "boulder": 4, "garden_plant": 6}
 """Most instances of a vegetation category kept per room (gardens list up to 64 trees)."""

@@ -37,7 +37,6 @@ TYPICAL_AREA_M2: dict[str, tuple[float, float]] = {
 """Plausible (min, max) floor area per BEHAVIOR room type; others get (10, 20)."""
 
 OUTDOOR_TYPES = frozenset({"garden"})
-VEHICLES = frozenset({"car", "recreational_vehicle", "motorcycle"})
 DOOR_HEIGHT_M = 2.1
 WINDOW_SILL_M, WINDOW_TOP_M = 0.9, 2.0
 FENCE_HEIGHT_M = 1.0
@@ -177,7 +176,7 @@ def _room_area(room_id: str, items: list[_Item], rng: np.random.Generator, clear
     free = sum((it.size[0] + k["walk"]) * (it.size[1] + k["walk"]) for it in floor if it.role == "free")
     walled = sum(max(it.size[:2]) * (min(it.size[:2]) + k["walk"]) for it in floor if it.role == "floor")
     need = max(clearance * footprint, 2.0 * free + 1.3 * walled) + 4.0
-    if _room_type(room_id) in OUTDOOR_TYPES and any(it.category in VEHICLES for it in items):
+    if _room_type(room_id) in OUTDOOR_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items):
         need += 30.0
     return max(float(rng.uniform(lo, hi)), need)
 
@@ -404,7 +403,7 @@ def _furnish_all(rects, items, doors, windows, rng, k) -> tuple[list[Furniture],
     for rid, rect in rects.items():
         keep = _keepouts(rid, rect, doors, windows, k)
         driveway = None
-        if _room_type(rid) in OUTDOOR_TYPES and any(it.category in VEHICLES for it in items[rid]):
+        if _room_type(rid) in OUTDOOR_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items[rid]):
             driveway = _driveway(rid, rect, rects, k)
             patches.append(GroundPatch(room=rid, bounds=_round(driveway), ground="driveway"))
         placed = furnish_room(rect, items[rid], keep, rng, driveway=driveway, k=k)

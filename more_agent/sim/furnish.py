@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from more_agent.sim.catalog import SUPPORT_CATEGORIES, WALL_MOUNTED_CATEGORIES
+from more_agent.sim.catalog import SUPPORT_CATEGORIES, VEHICLE_CATEGORIES, WALL_MOUNTED_CATEGORIES
 
 Rect = tuple[float, float, float, float]
 Vec3 = tuple[float, float, float]
@@ -82,7 +82,7 @@ def _try_furnish(inner, items, keepouts, rng, driveway, k):
     out: list[tuple[object, Vec3, Vec3]] = []
     for it in items:
         if it.role in ("floor", "free"):
-            region = driveway if it.category in ("car", "recreational_vehicle", "motorcycle") and driveway else None
+            region = driveway if it.category in VEHICLE_CATEGORIES else None
             got = _place_floor(inner, it, floor, rng, k["walk"], region)
             if got is None:
                 return None

@@ -104,8 +104,8 @@ def instantiate(task: str, scene: str | None = None, seed: int = 0) -> TaskInsta
     t0 = time.perf_counter()
     definition = load_task(task)
     t_parse = time.perf_counter() - t0
-    scenes = suitable_scenes(task)
     if scene is None:
+        scenes = suitable_scenes(task)
         if not scenes:
             raise InstantiationError(f"no BEHAVIOR-1K scene suits task {task!r} (its inroom requirements match none)")
         scene = scenes[0]
@@ -222,7 +222,7 @@ class _Builder:
     def _bind_ground_patch(self, scope: str, room_id: str) -> None:
         """Items put on a driveway / carpet scope go on the room's patch of that ground, if it has one."""
         ground = _ground_class(scope_synset(scope))
-        patches = [p.bounds for p in getattr(self.world.scene, "ground_patches", []) if p.room == room_id and p.ground == ground]
+        patches = [p.bounds for p in self.world.scene.ground_patches if p.room == room_id and p.ground == ground]
         if patches:
             self.areas[scope] = patches[0]
 
@@ -368,8 +368,8 @@ def _readable(world: World, name: str) -> str:
     if name == ROBOT_NAME:
         return "the robot"
     obj = world.objects.get(name)
-    if obj is None:
-        return name.rsplit("_", 1)[0].split(".")[0].replace("__", " ").replace("_", " ")
+    if obj is None:  # a virtual scope: its world name is the scope name
+        return category_phrase(scope_synset(name))
     if obj.kind == "floor":
         room = world.scene.room(obj.room) if obj.room else None
         return f"the {room.type.replace('_', ' ')} floor" if room else "the floor"
@@ -418,9 +418,9 @@ def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
             continue
         if obj.kind == "item" and not (obj.parent and world.objects[obj.parent].kind == "floor"):
             continue
-        lo, hi = obj.box()
+        x0, y0, x1, y1 = obj.footprint()
         pad = DOOR_KEEPOUT_M if obj.kind == "door" else 0.0
-        rows.append((lo[0] - pad, lo[1] - pad, hi[0] + pad, hi[1] + pad))
+        rows.append((x0 - pad, y0 - pad, x1 + pad, y1 + pad))
     return np.asarray(rows, dtype=float).reshape(-1, 4)
 
 

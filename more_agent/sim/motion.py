@@ -54,8 +54,7 @@ def obstacle_boxes(world: World, config: NavConfig = DEFAULT_NAV) -> np.ndarray:
             obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m
         )
         if blocks:
-            lo, hi = obj.box()
-            rows.append((lo[0], lo[1], hi[0], hi[1]))
+            rows.append(obj.footprint())
     return np.asarray(rows, dtype=np.float64).reshape(-1, 4)
 
 

@@ -138,8 +138,7 @@ def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
         blocked[opening] = door.id in closed
     for obj in world.objects.values():
         if obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m:
-            lo, hi = obj.box()
-            blocked[_mask_box(shape, origin, res, (lo[0], lo[1], hi[0], hi[1]))] = True
+            blocked[_mask_box(shape, origin, res, obj.footprint())] = True
 
     passable = region & ~blocked
     clearance = ndimage.distance_transform_edt(passable) * res
@@ -207,8 +206,8 @@ def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     forbids after a non-physical step); goals must be free themselves or are ignored.
     """
     start_cell = grid.snap(*start)
-    goal_cells = [grid.to_cell(*g) for g in goals if grid.is_free(*g)]
     goal_index = [i for i, g in enumerate(goals) if grid.is_free(*g)]
+    goal_cells = [grid.to_cell(*goals[i]) for i in goal_index]
     if start_cell is None or not goal_cells:
         return _NO_PATH
     costs = np.where(grid.free, 1.0, np.inf)

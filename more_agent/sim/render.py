@@ -74,7 +74,7 @@ class SceneGeometry:
     """The boxes a world draws (float64 corners, int32 class / instance ids) bucketed in a 2D grid.
 
     ``cell_start[c]:cell_start[c + 1]`` indexes ``cell_items``, the boxes overlapping cell c, with
-    c = iy * nx + ix.
+    c = iy * nx + ix. ``palette`` is the (n_classes, 3) float64 colour of each semantic class.
     """
 
     lo: np.ndarray
@@ -86,6 +86,7 @@ class SceneGeometry:
     shape: tuple[int, int]
     cell_start: np.ndarray
     cell_items: np.ndarray
+    palette: np.ndarray
 
     @property
     def n_boxes(self) -> int:
@@ -125,6 +126,7 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
         lo=lo, hi=hi, semantic=np.array([b[2] for b in boxes], dtype=np.int32),
         instance=np.array([b[3] for b in boxes], dtype=np.int32),
         origin=(x0, y0), cell=cell_m, shape=(nx, ny), cell_start=start, cell_items=items,
+        palette=class_colors(world.class_names).astype(np.float64),
     )
 
 
@@ -327,7 +329,7 @@ class Renderer:
         rgb = np.empty((n, 3), dtype=np.uint8)
         _cast(np.ascontiguousarray(T[:3, 3]), np.ascontiguousarray(T[:3, :3]), self._rays, cam.max_range_m,
               g.origin[0], g.origin[1], g.cell, g.shape[0], g.shape[1], g.cell_start, g.cell_items, g.lo, g.hi,
-              g.semantic, g.instance, class_colors(world.class_names).astype(np.float64), depth, sem, inst, rgb)
+              g.semantic, g.instance, g.palette, depth, sem, inst, rgb)
         hw = (cam.height, cam.width)
         return Frame(rgb=rgb.reshape(*hw, 3), depth=depth.reshape(hw), semantic=sem.reshape(hw), instance=inst.reshape(hw),
                      K=self._K.copy(), T_world_cam=T.copy())

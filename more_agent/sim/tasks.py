@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import json
 from collections import Counter
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
-from collections.abc import Callable
 from typing import Any
 
 import networkx as nx
@@ -62,13 +62,9 @@ class TaskDefinition:
         return atomic_predicates(self.goal)
 
     @property
-    def init_predicates(self) -> set[str]:
-        return {lit[1][0] if lit[0] == "not" else lit[0] for lit in self.init}
-
-    @property
     def n_goal_literals(self) -> int:
         """Number of atomic literals written in the goal (before quantifier expansion)."""
-        return _count_atoms(self.goal)
+        return sum(1 for _ in _atoms(self.goal))
 
     def room_requirements(self) -> dict[str, Counter[str]]:
         """Room type -> synset counts that the task's ``inroom`` literals require."""
@@ -84,35 +80,25 @@ def scope_synset(scope: str) -> str:
     return scope.lstrip("?").rsplit("_", 1)[0]
 
 
+def _atoms(node: Any) -> Iterator[ParsedLiteral]:
+    """The atomic literals (a predicate over terms) anywhere in a parse tree, in order.
+
+    Quantifier variable declarations (``['?x', '-', 'plate.n.04']``) and counts (``['2']``) are not atoms.
+    """
+    if not isinstance(node, list) or not node:
+        return
+    head = node[0]
+    if isinstance(head, str) and head not in LOGIC_TOKENS and all(isinstance(x, str) for x in node):
+        if not head.startswith("?") and not head.isdigit():
+            yield node
+        return
+    for child in node:
+        yield from _atoms(child)
+
+
 def atomic_predicates(parsed: list[ParsedLiteral]) -> set[str]:
     """Names of the atomic predicates used anywhere in a parse tree."""
-    out: set[str] = set()
-
-    def walk(node: Any) -> None:
-        if not isinstance(node, list) or not node:
-            return
-        head = node[0]
-        if isinstance(head, str) and head not in LOGIC_TOKENS and all(isinstance(x, str) for x in node):
-            if not head.startswith("?") and not head.isdigit():
-                out.add(head)
-            return
-        for child in node:
-            walk(child)
-
-    walk(parsed)
-    return out
-
-
-def _count_atoms(parsed: list[ParsedLiteral]) -> int:
-    def walk(node: Any) -> int:
-        if not isinstance(node, list) or not node:
-            return 0
-        head = node[0]
-        if isinstance(head, str) and head not in LOGIC_TOKENS:
-            return int(all(isinstance(x, str) for x in node) and not head.startswith("?") and not head.isdigit())
-        return sum(walk(child) for child in node[1:] if isinstance(child, list))
-
-    return sum(walk(lit) for lit in parsed)
+    return {atom[0] for atom in _atoms(parsed)}
 
 
 # -- catalogue ------------------------------------------------------------------------------------

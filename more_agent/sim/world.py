@@ -27,6 +27,9 @@ SLAB_FRACTION = 0.08
 SLOT_GAP_M = 0.02
 """Gap left between neighbouring items on one support."""
 
+CARRY_HEIGHT_M = 1.0
+"""Height of a held item's centre, above the robot base."""
+
 
 def floor_name(room_id: str) -> str:
     """Name of the floor object of a room (every room has one)."""
@@ -61,6 +64,11 @@ class WorldObject:
         half = self.size / 2
         return self.center - half, self.center + half
 
+    def footprint(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) of the box seen from above."""
+        (x0, y0, _), (x1, y1, _) = self.box()
+        return float(x0), float(y0), float(x1), float(y1)
+
     @property
     def top(self) -> float:
         return float(self.center[2] + self.size[2] / 2)
@@ -78,10 +86,6 @@ class RobotState:
     y: float = 0.0
     yaw: float = 0.0
     held: str | None = None
-
-    @property
-    def xy(self) -> np.ndarray:
-        return np.array([self.x, self.y])
 
 
 @dataclass
@@ -237,10 +241,12 @@ class World:
         self.version += 1
 
     def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
-        """Rest item ``name`` on a room floor at a given position (used by task instantiation)."""
+        """Rest item ``name`` on a room floor at a given position (no precondition checks)."""
         obj, support = self.objects[name], self.objects[floor]
         obj.parent, obj.relation, obj.room = floor, "ontop", support.room
         self._move_subtree(obj, np.array([xy[0], xy[1], support.top + obj.size[2] / 2]))
+        if self.robot.held == name:
+            self.robot.held = None
         self.version += 1
 
     def pick(self, name: str) -> None:
@@ -248,16 +254,21 @@ class World:
         obj = self.objects[name]
         obj.parent, obj.relation = None, None
         self.robot.held = name
+        self._carry()
         self.version += 1
 
     def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
+        self._carry()
+        self.version += 1
+
+    def _carry(self) -> None:
+        """Move the held item (and what rests in / on it) to the gripper, ``CARRY_HEIGHT_M`` above the base."""
         if self.robot.held is not None:
             held = self.objects[self.robot.held]
-            held.room = self.room_at(x, y)
-            self._move_subtree(held, np.array([x, y, 1.0]))
-        self.version += 1
+            held.room = self.room_at(self.robot.x, self.robot.y)
+            self._move_subtree(held, np.array([self.robot.x, self.robot.y, CARRY_HEIGHT_M]))
 
     def _move_subtree(self, obj: WorldObject, center: np.ndarray) -> None:
         """Move ``obj`` to ``center``; what rests in / on it moves by the same offset (and changes room)."""
