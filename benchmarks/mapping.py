@@ -28,20 +28,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / ".." / "shared" / "benchmarks"))
 from synth_apartment import make_apartment  # noqa: E402
 
-from more_agent.mapping import (  # noqa: E402
-    MappingConfig,
-    VoxelMap,
-    assign_objects,
-    door_crossing_edges,
-    doorway_mask,
-    fit_door_kernel,
-    frontier_points,
-    merge_subregions,
-    segment_regions,
-    sparsify,
-    voronoi_graph,
-)
-from more_agent.mapping.occupancy import OCCUPIED  # noqa: E402
+from more_agent.mapping import OCCUPIED, MappingConfig, VoxelMap, assign_objects, region_graph  # noqa: E402
 
 SIZES = (200, 400, 600, 1200, 2000)
 CFG = MappingConfig()
@@ -60,39 +47,20 @@ def _door_points(occ: np.ndarray, door: tuple[int, int], width: int = 12, wall: 
 
 
 def build_graph(occ, doors, objects, rooms) -> tuple[dict, dict]:
-    """The whole graph pipeline on one map; returns (seconds per stage, counts)."""
-    t = {}
-    t0 = time.perf_counter()
-    dense = voronoi_graph(occ, resolution_m=RES, inflation_m=CFG.inflation_m, min_separation_m=CFG.gvd_min_separation_m)
-    t["voronoi_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    graph, _ = sparsify(dense, threshold_m=CFG.sparsify_threshold_m)
-    t["sparsify_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    kernels = [fit_door_kernel(_door_points(occ, d), min_sigma_m=CFG.door_min_sigma_m) for d in doors]
-    cut = door_crossing_edges(graph, kernels, threshold_m=CFG.door_cut_threshold_m)
-    labels = segment_regions(graph, cut, kernels, doorway_value=CFG.door_mask_value)
-    doorway = doorway_mask(occ.shape, kernels, resolution_m=RES, value=CFG.door_mask_value)
-    labels = merge_subregions(labels, np.floor(graph.xy / RES).astype(int), occ, doorway)
-    t["regions_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    """The whole graph pipeline (``region_graph``) on one map; returns (seconds per stage, counts)."""
     obj_xy = (np.array([(o[0], o[1]) for o in objects]) + 0.5) * RES
     room_centres = np.array([((a0 + a1) / 2, (b0 + b1) / 2) for a0, a1, b0, b1 in rooms]) * RES
     vp = room_centres[[o[2] for o in objects]]
-    assigned = assign_objects(graph, labels, obj_xy, vp, cut=cut, blocked=occ == OCCUPIED, resolution_m=RES,
-                              lam=CFG.assignment_lambda, radius_m=CFG.assignment_radius_m, k=CFG.assignment_k)
-    t["assignment_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    frontier_points(occ, resolution_m=RES, min_length_m=CFG.min_frontier_m)
-    t["frontiers_s"] = time.perf_counter() - t0
-    truth = assign_objects(graph, labels, vp, vp, cut=cut, resolution_m=RES)
+    out = region_graph(occ, door_points=[_door_points(occ, d) for d in doors], objects_xy=obj_xy, viewpoints_xy=vp,
+                       blocked=occ == OCCUPIED, config=CFG)
+    truth = assign_objects(out.graph, out.labels, vp, vp, cut=out.cut, resolution_m=RES)
     counts = {
-        "nodes_dense": dense.n_nodes, "edges_dense": dense.n_edges,
-        "nodes_sparse": graph.n_nodes, "edges_sparse": graph.n_edges,
-        "regions": int(labels.max()) + 1, "rooms": len(rooms),
-        "assignment_accuracy": float(np.mean(assigned == truth)),
+        "nodes_dense": out.dense.n_nodes, "edges_dense": out.dense.n_edges,
+        "nodes_sparse": out.graph.n_nodes, "edges_sparse": out.graph.n_edges,
+        "regions": int(out.labels.max()) + 1, "rooms": len(rooms),
+        "assignment_accuracy": float(np.mean(out.assigned == truth)),
     }
-    return t, counts
+    return out.timings_s, counts
 
 
 def frame_update_s(n_frames: int = 30) -> float:

@@ -45,9 +45,3 @@ class NavGraph:
 
     def degrees(self) -> np.ndarray:
         return np.bincount(self.edges.ravel(), minlength=self.n_nodes)
-
-    def subgraph(self, keep: np.ndarray) -> NavGraph:
-        """The graph induced by the boolean node mask ``keep`` (node order preserved)."""
-        new_index = np.cumsum(keep) - 1
-        emask = keep[self.edges[:, 0]] & keep[self.edges[:, 1]]
-        return NavGraph(self.xy[keep], new_index[self.edges[emask]], self.weights[emask])

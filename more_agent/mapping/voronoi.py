@@ -6,8 +6,8 @@ Grid convention used throughout ``mapping``: ``grid[ix, iy]`` is the cell whose 
 The GVD is computed in time linear in the grid area: one Euclidean distance transform with
 feature indices (the ESDF), then a cell pair straddles the GVD when the nearest obstacle cells of
 two 4-neighbours lie far apart (brushfire criterion); the resulting band, two or three pixels
-wide, is thinned to one pixel by Zhang-Suen thinning over the band's pixels only. Obstacles are every non-free cell (occupied or unknown), so the diagram never leaves the
-observed free space.
+wide, is thinned to one pixel by Zhang-Suen thinning over the band's pixels only. Obstacles are
+every non-free cell (occupied or unknown), so the diagram never leaves the observed free space.
 """
 
 from __future__ import annotations
@@ -18,6 +18,20 @@ from scipy import ndimage
 
 from more_agent.mapping.graph import NavGraph
 from more_agent.mapping.occupancy import FREE
+
+
+@numba.njit(cache=True)
+def _clearance_mask(feat_r: np.ndarray, feat_c: np.ndarray, resolution: float, inflation: float) -> np.ndarray:
+    """Cells whose distance to their nearest obstacle cell (EDT feature indices) times
+    ``resolution`` exceeds ``inflation``; the distance is computed as scipy's EDT computes it."""
+    h, w = feat_r.shape
+    out = np.zeros((h, w), dtype=np.bool_)
+    for r in range(h):
+        for c in range(w):
+            a = float(feat_r[r, c] - r)
+            b = float(feat_c[r, c] - c)
+            out[r, c] = np.sqrt(a * a + b * b) * resolution > inflation
+    return out
 
 
 @numba.njit(cache=True)
@@ -127,9 +141,10 @@ def voronoi_graph(
     r0, c0 = rows[0] - 1, cols[0] - 1  # one non-free ring around the crop
     crop = np.zeros((rows[-1] - rows[0] + 3, cols[-1] - cols[0] + 3), dtype=bool)
     crop[1:-1, 1:-1] = free[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
-    dist, (feat_r, feat_c) = ndimage.distance_transform_edt(crop, return_indices=True)
-    domain = dist * resolution_m > inflation_m
-    band = _gvd_band(domain, feat_r.astype(np.int32), feat_c.astype(np.int32), (min_separation_m / resolution_m) ** 2)
+    # feature indices only (int32): the distances follow from them without scipy's float temporaries
+    feat_r, feat_c = ndimage.distance_transform_edt(crop, return_distances=False, return_indices=True)
+    domain = _clearance_mask(feat_r, feat_c, float(resolution_m), float(inflation_m))
+    band = _gvd_band(domain, feat_r, feat_c, (min_separation_m / resolution_m) ** 2)
     if not band.any():
         return NavGraph.empty()
     skel = _thin(band)

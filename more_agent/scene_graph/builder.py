@@ -1,9 +1,10 @@
 """``SceneGraphBuilder``: fuses frames incrementally and builds a ``SceneGraph`` per high-level step.
 
 ``integrate`` (every frame) only updates the voxel map and per-instance bookkeeping (attributes,
-viewpoints). ``build`` (once per step) runs the whole graph pipeline: BEV -> Voronoi graph ->
-sparsification -> door cuts -> regions (+ sub-region merging) -> stable region ids -> Eq. 1
-object assignment -> frontiers -> reduction to the robot's navigable component -> relations.
+viewpoints). ``build`` (once per step) runs the graph pipeline ``mapping.region_graph`` on the BEV
+(Voronoi graph -> sparsification -> door cuts -> regions (+ sub-region merging) -> Eq. 1 object
+assignment -> frontiers), then gives regions stable ids, reduces everything to the robot's
+navigable component and adds the spatial relations.
 
 Region ids: each region keeps an anchor point; at the next build a region inherits the id of the
 old anchor(s) whose nearest node (within ``2 * sparsify_threshold_m``) it contains, the smallest
@@ -21,21 +22,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from scipy.spatial import cKDTree
 
-from more_agent.mapping import (
-    MappingConfig,
-    NavGraph,
-    VoxelMap,
-    assign_objects,
-    door_crossing_edges,
-    doorway_mask,
-    fit_door_kernel,
-    frontier_points,
-    line_of_sight,
-    merge_subregions,
-    segment_regions,
-    sparsify,
-    voronoi_graph,
-)
+from more_agent.mapping import MappingConfig, NavGraph, RegionGraph, VoxelMap, line_of_sight, region_graph
 from more_agent.scene_graph.model import (
     Box3D,
     InstanceInfo,
@@ -111,43 +98,24 @@ class SceneGraphBuilder:
     # ---------------------------------------------------------------- per step
     def build(self, robot_xy: Sequence[float]) -> SceneGraph:
         """The scene graph of everything observed so far, reduced to the robot's component."""
-        cfg = self.config
-        res, origin = cfg.resolution_m, tuple(self.voxels.origin_xy)
+        origin = tuple(self.voxels.origin_xy)
         robot = np.asarray(robot_xy[:2], dtype=float)
         occ = self.voxels.occupancy()
         blocked = np.isin(self.voxels.top_class, self._structure_ids)
-        graph, _ = sparsify(
-            voronoi_graph(occ, resolution_m=res, origin_xy=origin, inflation_m=cfg.inflation_m,
-                          min_separation_m=cfg.gvd_min_separation_m),
-            threshold_m=cfg.sparsify_threshold_m,
-        )
         voxels = self.voxels.instance_voxels()
         for iid, pts in voxels.items():
             self._set_box(iid, pts)
-        doors = [fit_door_kernel(voxels[i][:, :2], min_sigma_m=cfg.door_min_sigma_m)
-                 for i in sorted(voxels) if i in self._instances and self._instances[i].category == "door"]
-        cut = door_crossing_edges(graph, doors, threshold_m=cfg.door_cut_threshold_m)
-        labels = segment_regions(graph, cut, doors, doorway_value=cfg.door_mask_value)
-        if cfg.merge_subregions and graph.n_nodes:
-            cells = np.floor((graph.xy - origin) / res).astype(int)
-            doorway = doorway_mask(occ.shape, doors, resolution_m=res, origin_xy=origin, value=cfg.door_mask_value)
-            labels = merge_subregions(labels, cells, occ, doorway)
-        region_ids = self._stable_ids(graph, labels)
-
-        objects = sorted(i for i in voxels if i in self._instances and not self._instances[i].held)
+        known = sorted(i for i in voxels if i in self._instances)
+        doors = [voxels[i][:, :2] for i in known if self._instances[i].category == "door"]
+        objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
-        assigned = assign_objects(
-            graph, labels, centres[:, :2], viewpoints, cut=cut, blocked=blocked, resolution_m=res,
-            origin_xy=origin, lam=cfg.assignment_lambda, radius_m=cfg.assignment_radius_m, k=cfg.assignment_k,
-        )
-
-        keep = self._robot_component(graph, robot, blocked, origin)
-        frontier_xy, _ = frontier_points(occ, resolution_m=res, origin_xy=origin, min_length_m=cfg.min_frontier_m)
-        frontier_label = self._attach(graph, labels, frontier_xy, blocked, origin)
-        kept_labels = np.unique(labels[keep & (labels >= 0)])
-        return self._assemble(graph, cut, labels, region_ids, keep, kept_labels, objects, assigned,
-                              frontier_xy, frontier_label, robot, occ, origin)
+        rg = region_graph(occ, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
+                          blocked=blocked, origin_xy=origin, config=self.config)
+        region_ids = self._stable_ids(rg.graph, rg.labels)
+        keep = self._robot_component(rg.graph, robot, blocked, origin)
+        frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, origin)
+        return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, origin)
 
     # ---------------------------------------------------------------- helpers
     def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
@@ -194,7 +162,6 @@ class SceneGraphBuilder:
                 claims.setdefault(int(labels[labelled[i]]), []).append(rid)
         ids: list[str] = []
         for lab in range(k):
-            members = np.flatnonzero(labels == lab)
             owned = sorted(claims.get(lab, []), key=lambda r: int(r.split("_")[1]))
             if owned:
                 rid = owned[0]
@@ -203,22 +170,24 @@ class SceneGraphBuilder:
             else:
                 rid = f"region_{self._next_region}"
                 self._next_region += 1
+                members = np.flatnonzero(labels == lab)
                 centre = graph.xy[members].mean(0)
                 self._anchors[rid] = graph.xy[members[np.argmin(np.linalg.norm(graph.xy[members] - centre, axis=1))]]
             ids.append(rid)
         return ids
 
-    def _assemble(self, graph, cut, labels, region_ids, keep, kept_labels, objects, assigned,
-                  frontier_xy, frontier_node, robot, occ, origin) -> SceneGraph:
-        """Put the reduced graph into the data model."""
+    def _assemble(self, rg: RegionGraph, region_ids: list[str], keep: np.ndarray, objects: list[int],
+                  frontier_node: np.ndarray, robot: np.ndarray, occ: np.ndarray, origin) -> SceneGraph:
+        """Put the pipeline's graph, reduced to the ``keep`` node mask, into the data model."""
+        graph, labels = rg.graph, rg.labels
         sub_index = np.cumsum(keep) - 1
         emask = keep[graph.edges[:, 0]] & keep[graph.edges[:, 1]]
         node_region = [region_ids[lab] if lab >= 0 else None for lab in labels[keep]]
-        kept = set(kept_labels.tolist())
+        kept = set(np.unique(labels[keep & (labels >= 0)]).tolist())
 
         obj_nodes: dict[str, ObjectNode] = {}
         region_objects: dict[int, list[str]] = {lab: [] for lab in kept}
-        for iid, lab in zip(objects, assigned.tolist()):
+        for iid, lab in zip(objects, rg.assigned.tolist()):
             if lab in kept:
                 node = self._object_node(iid, region_ids[lab])
                 obj_nodes[node.id] = node
@@ -232,7 +201,7 @@ class SceneGraphBuilder:
         for lab in sorted(kept):
             rid = region_ids[lab]
             members = np.flatnonzero(keep & (labels == lab))
-            fr = [tuple(map(float, p)) for p, n in zip(frontier_xy, frontier_node) if n >= 0 and labels[n] == lab]
+            fr = [tuple(map(float, p)) for p, n in zip(rg.frontier_xy, frontier_node) if n >= 0 and labels[n] == lab]
             regions[rid] = RegionNode(
                 id=rid, room_label=self._room_labels.get(rid), centroid=tuple(map(float, graph.xy[members].mean(0))),
                 nav_nodes=sub_index[members].tolist(), object_ids=sorted(region_objects[lab]), frontiers=fr,
@@ -249,7 +218,7 @@ class SceneGraphBuilder:
         labelled_kept = np.flatnonzero(keep & (labels >= 0))
         if labelled_kept.size:
             robot_node = labelled_kept[np.argmin(np.linalg.norm(graph.xy[labelled_kept] - robot, axis=1))]
-        held_id = obj_nodes[self._instances[held[0]].label].id if held else None
+        held_id = self._instances[held[0]].label if held else None  # object ids are instance labels
         self._step += 1
         return SceneGraph(
             step=self._step - 1,
@@ -258,7 +227,7 @@ class SceneGraphBuilder:
                             held_object=held_id),
             regions=regions, objects=obj_nodes, relations=relations,
             nav=NavGraphData(node_xy=graph.xy[keep], edges=sub_index[graph.edges[emask]],
-                             weights=graph.weights[emask], door_edges=cut[emask],
+                             weights=graph.weights[emask], door_edges=rg.cut[emask],
                              node_region=node_region),
             occupancy=OccupancyMap(grid=occ, origin_xy=(float(origin[0]), float(origin[1])),
                                    resolution_m=self.config.resolution_m),

@@ -17,8 +17,9 @@ def spatial_relations(
 
     A is inside B when at least ``inside_fraction`` of A's volume lies in B's box, A's top is
     below B's top and B is the larger box (the top test keeps a flat item resting on a table, whose
-    voxelised box shares the table's top voxel, from reading as inside it). Otherwise A is on top of B when A's bottom is within ``tol_m`` of B's top and at
-    least ``min_support_overlap`` of A's footprint lies over B's; the highest such support wins.
+    voxelised box shares the table's top voxel, from reading as inside it); the smallest such
+    container wins. Otherwise A is on top of B when A's bottom is within ``tol_m`` of B's top and
+    at least ``min_support_overlap`` of A's footprint lies over B's; the highest such support wins.
     """
     n = len(mins)
     if n < 2:

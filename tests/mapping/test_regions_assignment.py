@@ -3,16 +3,19 @@
 import numpy as np
 
 from more_agent.mapping import (
+    MappingConfig,
     assign_objects,
     door_crossing_edges,
     doorway_mask,
     fit_door_kernel,
     merge_subregions,
+    region_graph,
     segment_regions,
     sparsify,
     voronoi_graph,
 )
 from more_agent.mapping.occupancy import FREE, OCCUPIED
+from more_agent.mapping.pipeline import STAGES
 
 RES = 0.075
 
@@ -100,3 +103,18 @@ def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
     got = assign_objects(g, labels, obj, vp, cut=cut, blocked=window_wall, resolution_m=RES)
     indoor = labels[np.argmin(np.linalg.norm(g.xy - obj, axis=1) + 100 * (g.xy[:, 0] > 50 * RES))]
     assert got[0] == indoor
+
+
+def test_region_graph_chains_the_stages_and_times_each() -> None:
+    occ = _two_rooms()
+    obj = np.array([[25 * RES, 10 * RES], [75 * RES, 50 * RES]])
+    rg = region_graph(occ, door_points=[_door_points()], objects_xy=obj, viewpoints_xy=obj,
+                      blocked=occ == OCCUPIED, config=MappingConfig(resolution_m=RES))
+    g, cut, labels = _regions(occ, [fit_door_kernel(_door_points())])
+    np.testing.assert_array_equal(rg.graph.xy, g.xy)
+    np.testing.assert_array_equal(rg.cut, cut)
+    assert rg.dense.n_nodes > rg.graph.n_nodes
+    assert rg.labels.max() == 1
+    assert rg.assigned.tolist() == [labels[np.argmin(g.xy[:, 0])], labels[np.argmax(g.xy[:, 0])]]
+    assert len(rg.frontier_xy) == 0  # everything outside the rooms is occupied, nothing unknown
+    assert tuple(rg.timings_s) == STAGES and all(t >= 0 for t in rg.timings_s.values())

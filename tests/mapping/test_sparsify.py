@@ -39,8 +39,9 @@ def _check_invariants(graph: NavGraph, threshold: float) -> None:
         if len(lst) == 2:
             (u, w1), (v, w2) = lst
             assert w1 + w2 >= threshold or tuple(sorted((u, v))) in adjacent
-    # and it removed something whenever a removable node existed at all
-    assert sparse.n_nodes <= graph.n_nodes
+    # only degree-2 nodes are removed (removal never changes another node's degree)
+    removed = np.setdiff1d(np.arange(graph.n_nodes), kept)
+    assert (graph.degrees()[removed] == 2).all()
     assert (np.diff(kept) > 0).all()
 
 

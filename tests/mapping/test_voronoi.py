@@ -1,10 +1,10 @@
 """Voronoi graph: nodes on free cells with clearance, metric edges, passes doors."""
 
 import numpy as np
+from scipy import ndimage
 
 from more_agent.mapping import voronoi_graph
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
-
 
 
 def _cells(xy: np.ndarray, origin, res: float) -> np.ndarray:
@@ -21,7 +21,6 @@ def test_nodes_lie_on_free_cells_with_clearance_and_edges_are_metric() -> None:
     g = voronoi_graph(occ, resolution_m=res, origin_xy=origin, inflation_m=0.15)
     cells = _cells(g.xy, origin, res)
     assert (occ[cells[:, 0], cells[:, 1]] == FREE).all()
-    from scipy import ndimage
     clearance = ndimage.distance_transform_edt(occ == FREE) * res
     assert (clearance[cells[:, 0], cells[:, 1]] > 0.15).all()
     np.testing.assert_allclose(g.weights, np.linalg.norm(g.xy[g.edges[:, 0]] - g.xy[g.edges[:, 1]], axis=1))

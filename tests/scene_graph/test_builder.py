@@ -4,7 +4,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from more_agent.mapping import assign_objects, door_crossing_edges, fit_door_kernel, segment_regions, sparsify, voronoi_graph
+from more_agent.mapping import region_graph
 from more_agent.scene_graph import InstanceInfo, SceneGraph, load_scene_graph, to_networkx
 from tests.scene_graph.scenes import explore, house_and_garden, new_builder, two_rooms
 
@@ -75,18 +75,12 @@ def test_window_object_goes_indoors_and_unreachable_regions_are_dropped() -> Non
     garden = [r for r in g.regions.values() if r.centroid[0] > 4.1]
     assert garden and all("cabinet A" not in r.object_ids for r in garden)
     # Eq. 1 on the builder's own map: the cabinet, seen only from the garden, is indoors
-    cfg, vox = builder.config, builder.voxels
-    origin = tuple(vox.origin_xy)
-    graph, _ = sparsify(voronoi_graph(vox.occupancy(), resolution_m=cfg.resolution_m, origin_xy=origin), threshold_m=1.0)
+    vox = builder.voxels
     voxels = vox.instance_voxels()
-    doors = [fit_door_kernel(voxels[1][:, :2])]
-    cut = door_crossing_edges(graph, doors)
-    labels = segment_regions(graph, cut, doors)
-    centre = voxels[2].mean(0)[None, :2]
-    blocked = np.isin(vox.top_class, builder._structure_ids)
-    got = assign_objects(graph, labels, centre, np.array([[4.7, 1.0]]), cut=cut, blocked=blocked,
-                         resolution_m=cfg.resolution_m, origin_xy=origin)
-    assert graph.xy[labels == got[0]][:, 0].max() < 4.0
+    rg = region_graph(vox.occupancy(), door_points=[voxels[1][:, :2]], objects_xy=voxels[2].mean(0)[None, :2],
+                      viewpoints_xy=np.array([[4.7, 1.0]]), blocked=np.isin(vox.top_class, builder._structure_ids),
+                      origin_xy=tuple(vox.origin_xy), config=builder.config)
+    assert rg.graph.xy[rg.labels == rg.assigned[0]][:, 0].max() < 4.0
     # exploring inside makes the indoor region reachable with the cabinet in it
     explore(builder, boxes, infos, [(2.0, 2.5), (2.0, 1.6)], n_yaw=8)
     g2 = builder.build((6.0, 2.0))
