@@ -96,7 +96,7 @@ def run_episode(
     from more_agent.sim.instantiate import instantiate
 
     clock = _Clock()
-    record = EpisodeRecord(task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm)
+    record = EpisodeRecord.for_spec(spec)
     world: World | None = None
     goals: GoalChecker | None = None
     scope: dict[str, str] = {}

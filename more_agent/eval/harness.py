@@ -50,12 +50,6 @@ EpisodeFn = Callable[..., EpisodeRecord]
 # What to run
 
 
-def _default_task_set(name: str) -> list[str]:
-    from more_agent.sim.tasks import task_set  # lazy: workers need no task catalogue
-
-    return list(task_set(name))
-
-
 def check_task_names(names: Iterable[str]) -> None:
     """Raise a UserError naming the closest activities for the first unknown task name."""
     from more_agent.sim.tasks import task_names
@@ -71,12 +65,12 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
 
     Duplicates are dropped, order kept. Lines starting with '#' in a file are comments.
     """
-    from more_agent.sim.tasks import TASK_SETS
+    from more_agent.sim import tasks  # lazy: workers need no task catalogue
 
     arg = arg.strip()
     path = Path(arg)
-    if arg in TASK_SETS:
-        names = (task_set or _default_task_set)(arg)
+    if arg in tasks.TASK_SETS:
+        names = (task_set or tasks.task_set)(arg)
     elif path.is_file():
         text = path.read_text(encoding="utf-8")
         if text.lstrip().startswith("["):
@@ -94,7 +88,7 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
         names = [n.strip() for n in arg.split(",") if n.strip()]
     names = list(dict.fromkeys(n.strip() for n in names))
     if not names:
-        raise UserError(f"--tasks {arg!r} names no task; use a set ({', '.join(TASK_SETS)}), a file or 'a,b,c'")
+        raise UserError(f"--tasks {arg!r} names no task; use a set ({', '.join(tasks.TASK_SETS)}), a file or 'a,b,c'")
     return names
 
 
@@ -137,15 +131,7 @@ def resolve_episode_fn(path: str) -> EpisodeFn:
 
 def error_record(spec: EpisodeSpec, error: str, tb: str | None = None) -> EpisodeRecord:
     """The record of an episode that raised or whose worker died: a failure with its error."""
-    return EpisodeRecord(
-        task=spec.task,
-        scene=spec.scene or "",
-        seed=spec.seed,
-        planner=spec.planner,
-        llm=spec.llm,
-        error=error,
-        traceback=tb,
-    )
+    return EpisodeRecord.for_spec(spec, error=error, traceback=tb)
 
 
 def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:

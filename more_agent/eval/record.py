@@ -78,6 +78,11 @@ class EpisodeRecord(BaseModel):
         """Identity of the episode within a run: (task, scene, seed, planner)."""
         return (self.task, self.scene, self.seed, self.planner)
 
+    @classmethod
+    def for_spec(cls, spec: EpisodeSpec, **fields: object) -> EpisodeRecord:
+        """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
+        return cls(task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, **fields)
+
 
 class EpisodeSpec(BaseModel):
     """What to run: one (task, scene, seed, planner, llm) combination; the unit of evaluation work."""

@@ -119,16 +119,6 @@ class EpisodeWriter:
         self.close()
 
 
-def spec_matches(spec: EpisodeSpec, record: EpisodeRecord) -> bool:
-    """Whether ``record`` is the outcome of ``spec`` (a spec without scene matches any scene)."""
-    return (
-        record.task == spec.task
-        and record.seed == spec.seed
-        and record.planner == spec.planner
-        and (spec.scene is None or record.scene == spec.scene)
-    )
-
-
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
     """The specs with no record yet, in order."""
     done: dict[tuple[str, int, str], set[str]] = {}

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-from more_agent.errors import unknown_name_error
+from more_agent.errors import UserError, unknown_name_error
 from more_agent.eval.record import LLMUsage
 from more_agent.sim.actions import ActionResult
 
@@ -134,8 +134,8 @@ def make_planner(name: str, llm: str | None = None) -> Planner:
     if name in _registered:
         return _registered[name](llm)
     if name not in _BUILTIN:
-        err = unknown_name_error("planner", name, planner_names())
-        raise type(err)(f"{err}; available: {', '.join(planner_names())}")
+        names = planner_names()
+        raise UserError(f"{unknown_name_error('planner', name, names)}; available: {', '.join(names)}")
     module, attr = _BUILTIN[name].split(":")
     factory: PlannerFactory = getattr(importlib.import_module(module), attr)
     return factory(llm)

@@ -61,7 +61,6 @@ from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, Policy
 from more_agent.planners.policies.skills import pick_target
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.viz.frames import FRAMES_DIR, FrameWriter
 from more_agent.viz.graph_plot import save_step_graph
 
 log = logging.getLogger(__name__)
@@ -169,10 +168,8 @@ class LLMPlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
-        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
+        self.body = Embodiment.for_episode(context, config=self.config.policy, mapping=self.config.mapping)
         self.out_dir, self.save_graph = context.out_dir, context.save_graph
-        if context.save_frames and self.out_dir is not None:
-            self.body.on_frame = FrameWriter(self.out_dir / FRAMES_DIR, context.instance.world.class_names)
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
@@ -298,6 +295,9 @@ class LLMPlanner:
             return view
         completions.extend(answer.completions)
         self._add(answer.completions)
+        if answer.value.unknown_rooms or answer.value.unknown_objects:
+            log.warning("filter answer named unknown rooms %s / objects %s: ignored",
+                        answer.value.unknown_rooms, answer.value.unknown_objects)
         return view.filtered(answer.value, always={view.robot_room})
 
     def _run(self, action: HighLevelAction) -> ActionResult:

@@ -37,7 +37,6 @@ from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
 from more_agent.sim.world import World, WorldObject
-from more_agent.viz.frames import FRAMES_DIR, FrameWriter
 from more_agent.viz.graph_plot import save_step_graph
 
 ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
@@ -168,9 +167,7 @@ class OraclePlanner:
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
         self._observed: set[str] = set()
-        self._body = Embodiment(self._world)
-        if context.save_frames and context.out_dir is not None:
-            self._body.on_frame = FrameWriter(context.out_dir / FRAMES_DIR, self._world.class_names)
+        self._body = Embodiment.for_episode(context)
         self._graph_dir = context.out_dir if context.save_graph else None
         self._steps = 0
         self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)

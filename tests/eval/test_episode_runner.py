@@ -5,9 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.eval.metrics import rtp
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec, LLMUsage
 from more_agent.planners.base import EpisodeContext, HighLevelAction
+from more_agent.planners.oracle import OraclePlanner
 from more_agent.sim.actions import ActionResult
 
 SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
@@ -31,6 +32,10 @@ def test_observed_objects_match_goal_condition_names_so_rtp_counts_them() -> Non
     assert rtp(record) == 1.0
 
 
+NOTHING_HAPPENS = ActionResult(ok=False, reason=None, feedback="nothing happens")
+"""The result of waiting in place: a failing no-op."""
+
+
 class _Idle:
     """A planner that never finishes: it waits in place (a failing no-op) forever."""
 
@@ -38,7 +43,7 @@ class _Idle:
     llm = None
 
     def reset(self, context: EpisodeContext) -> None:
-        self.world = context.instance.world
+        pass
 
     def observe(self) -> None:
         pass
@@ -47,14 +52,12 @@ class _Idle:
         return HighLevelAction("wait")
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        return ActionResult(ok=False, reason=None, feedback="nothing happens")
+        return NOTHING_HAPPENS
 
     def observed_objects(self) -> set[str]:
         return set()
 
-    def llm_usage(self):  # noqa: ANN201 - protocol signature
-        from more_agent.eval.record import LLMUsage
-
+    def llm_usage(self) -> LLMUsage:
         return LLMUsage()
 
 
@@ -64,21 +67,15 @@ def test_step_limit_ends_the_episode_with_the_reason() -> None:
     assert record.error == f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
 
 
-class _SolveThenLinger(_Idle):
-    """Delegates to the oracle until it would call done(), then keeps waiting instead."""
-
-    def reset(self, context: EpisodeContext) -> None:
-        from more_agent.planners.oracle import OraclePlanner
-
-        self.oracle = OraclePlanner()
-        self.oracle.reset(context)
+class _SolveThenLinger(OraclePlanner):
+    """The oracle, except that where it would call done() it keeps waiting instead."""
 
     def decide(self) -> HighLevelAction:
-        action = self.oracle.decide()
+        action = super().decide()
         return HighLevelAction("wait") if action.is_done else action
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        return super().execute(action) if action.name == "wait" else self.oracle.execute(action)
+        return NOTHING_HAPPENS if action.name == "wait" else super().execute(action)
 
 
 def test_acting_on_after_the_goal_holds_ends_after_five_steps_without_success() -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -21,6 +22,9 @@ from more_agent.sim.motion import full_turn_angles, move_forward, turn
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
+
+if TYPE_CHECKING:
+    from more_agent.planners.base import EpisodeContext
 
 
 class PolicyConfig(BaseModel):
@@ -65,6 +69,19 @@ class Embodiment:
         self.on_frame: Callable[[Frame], None] | None = None
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
+
+    @classmethod
+    def for_episode(
+        cls, context: EpisodeContext, *, config: PolicyConfig | None = None, mapping: MappingConfig | None = None
+    ) -> Embodiment:
+        """The robot in the episode's world; with ``context.save_frames`` every rendered frame is written
+        under ``out_dir/frames``."""
+        body = cls(context.instance.world, config=config, mapping=mapping)
+        if context.save_frames and context.out_dir is not None:
+            from more_agent.viz.frames import FRAMES_DIR, FrameWriter  # lazy: matplotlib only when writing frames
+
+            body.on_frame = FrameWriter(context.out_dir / FRAMES_DIR, body.world.class_names)
+        return body
 
     @property
     def xy(self) -> XY:
