@@ -6,9 +6,25 @@ Written as ``DIR/episode.json`` by ``more-agent run`` and as one line of ``DIR/e
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
-RECORD_SCHEMA_VERSION = 1
+RECORD_SCHEMA_VERSION = 2
+
+FailureCause = Literal[
+    "never_observed",
+    "unreachable",
+    "subpolicy_failure",
+    "wrong_instance",
+    "done_not_called",
+    "done_early",
+    "step_limit",
+    "invalid_llm_answers",
+    "llm_error",
+    "other",
+]
+"""Why an unsuccessful episode failed; the classes are documented in docs/evaluation.md."""
 
 
 class GoalCondition(BaseModel):
@@ -45,6 +61,30 @@ class LLMUsage(BaseModel):
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 
+class WorldStats(BaseModel):
+    """How hard the episode's world was: its size, its clutter and how far the robot starts from the task."""
+
+    model_config = ConfigDict(frozen=True)
+
+    objects: int = Field(description="Objects in the world (furniture and items, task objects included).")
+    task_objects: int = Field(description="Objects bound to the task's object scope.")
+    distractors: int = Field(description="Movable items that are not task objects.")
+    start_room: str = Field(description="Room the robot starts in.")
+    task_rooms: list[str] = Field(default_factory=list, description="Rooms holding task objects at the start.")
+    start_to_task_m: float | None = Field(
+        default=None, description="Path length on the true map from the start pose to the nearest task object."
+    )
+
+
+class Failure(BaseModel):
+    """The cause of an unsuccessful episode, from its own trace and the world's ground truth afterwards."""
+
+    model_config = ConfigDict(frozen=True)
+
+    cause: FailureCause = Field(description="The failure class (docs/evaluation.md).")
+    detail: str = Field(default="", description="One line naming the objects, literal or reason involved.")
+
+
 class EpisodeRecord(BaseModel):
     """Everything one episode produced; the same task, scene and seed give the same record, timings aside."""
 
@@ -71,7 +111,12 @@ class EpisodeRecord(BaseModel):
     )
     llm_usage: LLMUsage = Field(default_factory=LLMUsage)
     timings: dict[str, float] = Field(default_factory=dict, description="Seconds per phase, e.g. 'instantiate'.")
+    world_stats: WorldStats | None = Field(default=None, description="Size and difficulty of the world; None if not built.")
+    failure: Failure | None = Field(default=None, description="Why the episode failed; None for a success.")
     error: str | None = Field(default=None, description="None, or why the episode ended abnormally.")
+    retryable: bool = Field(
+        default=False, description="The error is transient (LLM transport, worker death, timeout): worth re-running."
+    )
     traceback: str | None = Field(default=None, description="Python traceback when the episode raised.")
 
     def key(self) -> tuple[str, str, int, str]:
