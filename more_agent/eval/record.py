@@ -58,6 +58,11 @@ class LLMUsage(BaseModel):
     completion_tokens: int = 0
     cost_usd: float = 0.0
     cache_hits: int = 0
+    images: int = Field(default=0, description="Images sent (vision planners).")
+    image_bytes: int = Field(default=0, description="Bytes of the images sent (decoded PNG).")
+    image_tokens: int = Field(
+        default=0, description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server)."
+    )
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 

@@ -1,0 +1,173 @@
+"""The BUMBLE planners against a fake OpenAI server speaking the chat API, images included."""
+
+from __future__ import annotations
+
+import io
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from more_agent.eval.episode import run_episode
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.llm import CacheMode, LLMConfig, make_client
+from more_agent.llm.images import LOW_DETAIL_TOKENS
+from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
+from more_agent.planners.llm_planner import INVALID, STEPS_FILE
+from tests.fakes.openai_server import request_images, request_text
+from tests.planners.brain import BrainServer
+from tests.planners.test_llm_episode import GOAL, KITCHEN, TASK
+from tests.planners.vlm_brain import RearrangeVLM, kind, step
+
+SPEC = EpisodeSpec(task=TASK, scene=str(KITCHEN), seed=0, planner="bumble", llm="openai:fake-model")
+
+
+def _run(server: BrainServer, tmp_path: Path, planner: str = "bumble", **kw: Any) -> tuple[EpisodeRecord, BumblePlanner]:
+    base = dict(base_url=server.base_url, api_key="sk-test", timeout_s=2.0, max_retries=0,
+                cache_path=tmp_path / "cache.sqlite")
+    client = make_client("openai:fake-model", LLMConfig(**{**base, **kw}))
+    bumble = BumblePlanner(BUMBLE_CONFIGS[planner], client, "openai:fake-model")
+    record = run_episode(SPEC.model_copy(update={"planner": planner}), planner=bumble, out_dir=tmp_path / "ep")
+    return record, bumble
+
+
+def _decode(png: bytes) -> np.ndarray:
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+
+@pytest.fixture(scope="module")
+def solved(tmp_path_factory: pytest.TempPathFactory) -> tuple[EpisodeRecord, BumblePlanner, BrainServer, Path]:
+    tmp = tmp_path_factory.mktemp("bumble")
+    with BrainServer(RearrangeVLM(GOAL)) as server:
+        record, planner = _run(server, tmp)
+    return record, planner, server, tmp
+
+
+def test_scripted_vlm_completes_the_episode(solved: Any) -> None:
+    record, _, server, tmp = solved
+    assert record.error is None and record.success and record.done_called, record.actions
+    names = [a.name for a in record.actions]
+    assert "go_to_and_open" in names and "go_to_and_place_inside" in names
+    assert record.llm_usage.calls == len(server.requests)
+    assert record.llm_usage.images == sum(len(request_images(r.body)) for r in server.requests) > 0
+    assert record.llm_usage.image_tokens == LOW_DETAIL_TOKENS * record.llm_usage.images
+    steps = [json.loads(line) for line in (tmp / "ep" / STEPS_FILE).read_text().splitlines()]
+    assert len(steps) == record.high_level_steps and steps[0]["buffer_frames"] > 5
+
+
+def test_requests_carry_decodable_pngs_of_the_frame_size_within_the_bound(solved: Any) -> None:
+    _, planner, server, _ = solved
+    for r in server.requests:
+        images = request_images(r.body)
+        assert len(images) <= planner.config.memory.max_images
+        for png in images:
+            assert _decode(png).shape == (256, 256, 3)
+        parts = r.body["messages"][-1]["content"]
+        if images:
+            assert all(p["image_url"]["detail"] == "low" for p in parts if p["type"] == "image_url")
+    kinds = {kind(r.body) for r in server.requests}
+    assert {"plan", "landmark", "object"} <= kinds
+
+
+def test_marks_drawn_are_the_objects_listed(solved: Any) -> None:
+    """In every object question, each listed mark's number is drawn on that object's pixels."""
+    _, planner, server, _ = solved
+    graph = planner.graph
+    checked = 0
+    for r in server.requests:
+        if kind(r.body) != "object":
+            continue
+        (png,) = request_images(r.body)
+        image = _decode(png)
+        listed = [line.split(": ", 1) for line in request_text(r.body).splitlines() if line[:1].isdigit() and ": " in line]
+        assert [int(n) for n, _ in listed] == list(range(1, len(listed) + 1))
+        labels = {o.label for o in graph.objects.values()}
+        for _, description in listed:
+            assert description.split(" [")[0] in labels
+        white = (image == 255).all(axis=2)
+        assert white.sum() >= len(listed) * 50  # a white disc per mark
+        checked += 1
+    assert checked > 0
+
+
+def test_marks_match_instance_ids_on_a_frame(solved: Any) -> None:
+    _, planner, _, _ = solved
+    frame = max(planner.memory.frames, key=lambda f: len(f.instance_ids))
+    ids = planner.markable(frame.instance_ids)
+    picture, marked = planner.marked_picture(frame.rgb(), frame.instance(), ids, "Frame:")
+    assert sorted(marked) == sorted(o for o in ids if planner.graph.objects[o].instance_id in frame.instance_ids)
+    from more_agent.planners.set_of_marks import annotate_marks
+
+    instance = frame.instance()
+    marks = annotate_marks(frame.rgb(), instance, [planner.graph.objects[o].instance_id for o in marked]).marks
+    for mark, object_id in zip(marks, marked, strict=True):
+        u, v = mark.anchor
+        assert instance[v, u] == planner.graph.objects[object_id].instance_id
+    assert _decode(picture.png).shape == (256, 256, 3)
+
+
+class Short:
+    """``RearrangeVLM`` that ends the episode at its third step decision; with ``question``, it first
+    answers that question (landmark or object) ``bad`` times with an out-of-range number."""
+
+    def __init__(self, question: str = "", bad: int = 0) -> None:
+        self.question, self.bad = question, bad
+        self.inner = RearrangeVLM(GOAL)
+        self.plans = 0
+
+    def __call__(self, body: dict[str, Any]) -> str:
+        if kind(body) == "plan":
+            self.plans += 1
+            if self.plans == 3:
+                return step("done", "stop here")
+        if kind(body) == self.question and self.bad > 0:
+            self.bad -= 1
+            return json.dumps({"reasoning": "", "frame" if self.question == "landmark" else "mark": 99})
+        return self.inner(body)
+
+
+@pytest.mark.parametrize("question", ["landmark", "object"])
+def test_invalid_index_is_reasked_then_an_invalid_action(tmp_path: Path, question: str) -> None:
+    with BrainServer(Short(question, bad=1)) as server:
+        record, _ = _run(server, tmp_path / "once")
+    assert record.error is None and INVALID not in [a.name for a in record.actions]  # one re-ask fixed it
+    reasks = [r for r in server.requests if "cannot be used" in request_text(r.body)]
+    assert reasks and "99" in request_text(reasks[0].body)
+
+    brain = Short(question, bad=3)  # the first ask and both re-asks are wrong
+    with BrainServer(brain) as server:
+        record, _ = _run(server, tmp_path / "thrice")
+    assert record.error is None and record.traceback is None
+    acted = next(a for a in record.actions if a.name != "explore")
+    assert acted.name == INVALID and not acted.ok
+    assert "invalid answer" in acted.feedback and "99" in acted.feedback
+
+
+def test_replay_from_the_cache_gives_the_same_episode(tmp_path: Path) -> None:
+    with BrainServer(Short()) as server:
+        first, _ = _run(server, tmp_path)
+        replayed, _ = _run(server, tmp_path, cache_mode=CacheMode.REPLAY)
+    assert first.error is None and replayed.error is None and first.llm_usage.images > 0
+    assert [(a.name, a.arguments, a.ok) for a in replayed.actions] == [(a.name, a.arguments, a.ok) for a in first.actions]
+    assert replayed.trajectory == first.trajectory
+    assert replayed.llm_usage.cache_hits == replayed.llm_usage.calls == first.llm_usage.calls
+    assert replayed.llm_usage.images == first.llm_usage.images
+
+
+def test_filtering_marks_only_task_objects_and_their_containers(tmp_path: Path) -> None:
+    with BrainServer(Short()) as server:
+        record, _ = _run(server, tmp_path, planner="bumble-filter")
+    assert record.error is None and any(kind(r.body) == "filter" for r in server.requests)
+    task_objects = set(GOAL) | set(GOAL.values())
+    listed = 0
+    for r in server.requests:
+        if kind(r.body) in ("object", "plan"):
+            entries = [line.split(": ", 1)[1] for line in request_text(r.body).splitlines() if line[:1].isdigit() and ": " in line]
+            holders = {e.split("[inside ", 1)[1].rstrip("]") for e in entries if "[inside " in e}
+            assert {e.split(" [")[0] for e in entries} <= task_objects | holders, entries
+            listed += len(entries)
+    assert listed > 0
