@@ -18,7 +18,8 @@ the planner reasons over images instead of a scene text.
   (``navigate_to_point_on_ground``) shows that frame with numbered marks and asks for a mark.
 - **Exploring**: the VLM picks one of the buffer frames that show unexplored areas; the robot explores
   the closest area seen in it. The VLM then sees the frames acquired during the exploration and says
-  whether the subtask was achieved: that verdict is the feedback.
+  whether the subtask was achieved: that verdict is the action's success flag and feedback (so an
+  exploration that found nothing enters the long-term memory of failed actions).
 - **``bumble-filter``**: MORE's filter (its prompt and parser) on the objects the VLM could be shown;
   only the kept objects are marked and listed, and frames are chosen to show them.
 
@@ -284,20 +285,21 @@ class BumblePlanner:
         frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
         return Decision(subtask=subtask, frontiers=frontiers)
 
-    def _verdict(self, subtask: str, frames: Sequence[MemoryFrame]) -> str:
-        """The VLM's feedback on an exploration: was the subtask achieved, seen the frames acquired during it?"""
+    def _verdict(self, subtask: str, frames: Sequence[MemoryFrame]) -> tuple[bool, str]:
+        """(achieved, feedback) of an exploration, from the VLM shown the frames acquired during it.
+        Without frames or a usable answer the exploration counts as done (its motion succeeded)."""
         shown = spread(frames, self.config.memory.max_images)
         if not shown:
-            return "no new view"
+            return True, "explored; no new view"
         try:
             achieved, why = self._ask(
                 frames_messages("bumble_verify", task=self.task, subtask=subtask, pictures=self._pictures(shown)),
                 VerifyAnswer, parse_verdict, "verify",
             )
         except InvalidAnswer as e:
-            return f"no verdict on the subtask ({e.reason})"
+            return True, f"explored; no verdict on the subtask ({e.reason})"
         verdict = "subtask achieved" if achieved else "subtask not achieved"
-        return f"{verdict}: {why}" if why else verdict
+        return achieved, f"{verdict}: {why}" if why else verdict
 
     def _filter(self, view: SceneView) -> set[str]:
         """MORE's filter on every object the VLM could be shown, as one room; all kept when the answer is unusable."""
@@ -342,8 +344,8 @@ class BumblePlanner:
             result = explore_frontiers(body, graph, decision.frontiers, "the chosen frame")
             if not result.ok:
                 return result
-            return ActionResult(ok=True, reason=None, feedback=self._verdict(decision.subtask, self.memory.since(first)),
-                                low_level_steps=result.low_level_steps)
+            achieved, feedback = self._verdict(decision.subtask, self.memory.since(first))
+            return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
         target: ObjectNode = graph.objects[decision.target or ""]
         if action.name == "navigate":
             return navigate(body, graph, target)
