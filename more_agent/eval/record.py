@@ -97,7 +97,7 @@ class EpisodeRecord(BaseModel):
     task: str = Field(description="BEHAVIOR-1K activity name.")
     scene: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(description="Seed of scene generation and task instantiation.")
-    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr'.")
+    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'.")
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
     description: str = Field(default="", description="Language description the planner received.")
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")

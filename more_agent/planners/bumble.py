@@ -112,6 +112,8 @@ class StepLog:
     completions: list[Completion] = field(default_factory=list)
     offered_frames: list[int] = field(default_factory=list)
     """Buffer indices of the frames offered in the landmark / exploration question."""
+    frame: int | None = None
+    """Buffer index of the frame the VLM picked."""
     marks: dict[int, str] = field(default_factory=dict)
     """Mark number -> object id of the object step's image."""
 
@@ -260,6 +262,7 @@ class BumblePlanner:
         k = self._ask(frames_messages("bumble_landmark", task=self.task, subtask=subtask, pictures=pictures),
                       FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "landmark")
         frame = offered[k - 1]
+        self.log.frame = frame.index
         picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
         self.log.marks = dict(enumerate(marked, start=1))
         m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
@@ -282,6 +285,7 @@ class BumblePlanner:
         k = self._ask(frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
                       FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "explore")
         chosen = offered[k - 1]
+        self.log.frame = chosen.index
         frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
         return Decision(subtask=subtask, frontiers=frontiers)
 
@@ -355,7 +359,7 @@ class BumblePlanner:
     def _write_step(self, out: Path, action: HighLevelAction) -> None:
         line = {
             "step": self.history[-1].step, "action": self.history[-1].model_dump(), "subtask": action.note,
-            "offered_frames": self.log.offered_frames, "marks": self.log.marks, "buffer_frames": len(self.memory.frames),
+            "offered_frames": self.log.offered_frames, "frame": self.log.frame, "marks": self.log.marks, "buffer_frames": len(self.memory.frames),
         }
         with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
             f.write(json.dumps(line) + "\n")

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import io
 import json
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +17,7 @@ from more_agent.llm import CacheMode, LLMConfig, make_client
 from more_agent.llm.images import LOW_DETAIL_TOKENS
 from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
 from more_agent.planners.llm_planner import INVALID, STEPS_FILE
+from more_agent.planners.set_of_marks import annotate_marks
 from tests.fakes.openai_server import request_images, request_text
 from tests.planners.brain import BrainServer
 from tests.planners.test_llm_episode import GOAL, KITCHEN, TASK
@@ -73,41 +73,40 @@ def test_requests_carry_decodable_pngs_of_the_frame_size_within_the_bound(solved
     assert {"plan", "landmark", "object"} <= kinds
 
 
-def test_marks_drawn_are_the_objects_listed(solved: Any) -> None:
-    """In every object question, each listed mark's number is drawn on that object's pixels."""
-    _, planner, server, _ = solved
-    graph = planner.graph
-    checked = 0
-    for r in server.requests:
-        if kind(r.body) != "object":
-            continue
-        (png,) = request_images(r.body)
-        image = _decode(png)
-        listed = [line.split(": ", 1) for line in request_text(r.body).splitlines() if line[:1].isdigit() and ": " in line]
-        assert [int(n) for n, _ in listed] == list(range(1, len(listed) + 1))
-        labels = {o.label for o in graph.objects.values()}
-        for _, description in listed:
-            assert description.split(" [")[0] in labels
-        white = (image == 255).all(axis=2)
-        assert white.sum() >= len(listed) * 50  # a white disc per mark
-        checked += 1
-    assert checked > 0
+def test_marks_sent_are_drawn_on_the_listed_objects(solved: Any) -> None:
+    """Each object question's image is the picked memory frame with a mark k on the object listed as k."""
+    _, planner, server, tmp = solved
+    steps = [json.loads(line) for line in (tmp / "ep" / STEPS_FILE).read_text().splitlines()]
+    marked_steps = [s for s in steps if s["marks"]]
+    questions = [r for r in server.requests if kind(r.body) == "object"]
+    assert len(questions) == len(marked_steps) > 0
+    objects = planner.graph.objects
+    for request, logged in zip(questions, marked_steps, strict=True):
+        listed = [line.split(": ", 1) for line in request_text(request.body).splitlines() if line[:1].isdigit()]
+        marks = {int(k): o for k, o in logged["marks"].items()}
+        assert [int(k) for k, _ in listed] == sorted(marks)
+        assert all(d.split(" [")[0] == objects[marks[int(k)]].label for k, d in listed)
+        frame = planner.memory.frames[logged["frame"]]
+        instance = frame.instance()
+        drawn = annotate_marks(frame.rgb(), instance, [objects[marks[k]].instance_id for k in sorted(marks)])
+        (png,) = request_images(request.body)
+        assert np.array_equal(_decode(png), drawn.rgb)
+        for mark in drawn.marks:
+            u, v = mark.anchor
+            assert instance[v, u] == objects[marks[mark.number]].instance_id
 
 
-def test_marks_match_instance_ids_on_a_frame(solved: Any) -> None:
+def test_a_mark_sits_on_its_object_and_background_is_never_marked(solved: Any) -> None:
     _, planner, _, _ = solved
     frame = max(planner.memory.frames, key=lambda f: len(f.instance_ids))
-    ids = planner.markable(frame.instance_ids)
-    picture, marked = planner.marked_picture(frame.rgb(), frame.instance(), ids, "Frame:")
-    assert sorted(marked) == sorted(o for o in ids if planner.graph.objects[o].instance_id in frame.instance_ids)
-    from more_agent.planners.set_of_marks import annotate_marks
-
     instance = frame.instance()
-    marks = annotate_marks(frame.rgb(), instance, [planner.graph.objects[o].instance_id for o in marked]).marks
-    for mark, object_id in zip(marks, marked, strict=True):
+    drawn = annotate_marks(frame.rgb(), instance, [0, *sorted(frame.instance_ids)])
+    assert [m.instance_id for m in drawn.marks] == sorted(frame.instance_ids)  # 0 (floor, walls) gets none
+    for mark in drawn.marks:
         u, v = mark.anchor
-        assert instance[v, u] == planner.graph.objects[object_id].instance_id
-    assert _decode(picture.png).shape == (256, 256, 3)
+        assert instance[v, u] == mark.instance_id
+        mask = instance == mark.instance_id
+        assert (drawn.rgb[mask] != frame.rgb()[mask]).any()  # outline or disc drawn on it
 
 
 class Short:
