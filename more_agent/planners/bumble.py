@@ -107,9 +107,8 @@ class Decision:
 
 @dataclass
 class StepLog:
-    """One step's VLM exchange, for ``steps.jsonl`` and tests."""
+    """What one step showed and got picked, for ``steps.jsonl``."""
 
-    completions: list[Completion] = field(default_factory=list)
     offered_frames: list[int] = field(default_factory=list)
     """Buffer indices of the frames offered in the landmark / exploration question."""
     frame: int | None = None
@@ -142,7 +141,7 @@ class BumblePlanner:
         self.current: Frame | None = None
         """The latest rendered frame: the current view."""
         self.decision = Decision()
-        self.log = StepLog()
+        self.step_log = StepLog()
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
@@ -172,7 +171,7 @@ class BumblePlanner:
         """Build the scene graph (map, objects, frontiers), describe its objects, filter them (``bumble-filter``)."""
         body = self._body()
         self.memory.step = len(self.history)
-        self.log = StepLog()
+        self.step_log = StepLog()
         self.graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
@@ -257,14 +256,14 @@ class BumblePlanner:
         offered = covering_frames(frames, wanted, self.config.memory.max_images)
         if not offered:
             return Decision(subtask=subtask, failure="no object to go to has been seen yet")
-        self.log.offered_frames = [f.index for f in offered]
+        self.step_log.offered_frames = [f.index for f in offered]
         pictures = self._pictures(offered)
         k = self._ask(frames_messages("bumble_landmark", task=self.task, subtask=subtask, pictures=pictures),
                       FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "landmark")
         frame = offered[k - 1]
-        self.log.frame = frame.index
+        self.step_log.frame = frame.index
         picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
-        self.log.marks = dict(enumerate(marked, start=1))
+        self.step_log.marks = dict(enumerate(marked, start=1))
         m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
                                       objects=[self.descriptions[o] for o in marked]),
                       MarkAnswer, lambda a: parse_choice(a, "mark", len(marked)), "object")
@@ -281,11 +280,11 @@ class BumblePlanner:
                                   shown=lambda f: seen[f.index])
         if not offered:
             return Decision(subtask=subtask, failure="no unexplored area in view of the robot's memory")
-        self.log.offered_frames = [f.index for f in offered]
+        self.step_log.offered_frames = [f.index for f in offered]
         k = self._ask(frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
                       FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "explore")
         chosen = offered[k - 1]
-        self.log.frame = chosen.index
+        self.step_log.frame = chosen.index
         frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
         return Decision(subtask=subtask, frontiers=frontiers)
 
@@ -322,11 +321,17 @@ class BumblePlanner:
         return {i for r in flat.filtered(kept).rooms for o in r.objects for i in o.ids}
 
     def _ask(
-        self, messages: list[ChatMessage], schema: type[BaseModel], validate: Callable[[str | Mapping[str, Any]], T], purpose: str
+        self,
+        messages: list[ChatMessage],
+        schema: type[BaseModel],
+        validate: Callable[[str | Mapping[str, Any]], T],
+        purpose: str,
     ) -> T:
         """ask_validated with this planner's re-asks; every completion is counted, also when it raises."""
         try:
-            answer = ask_validated(self.client, messages, schema, validate, max_reasks=self.config.max_reasks, purpose=purpose)
+            answer = ask_validated(
+                self.client, messages, schema, validate, max_reasks=self.config.max_reasks, purpose=purpose
+            )
         except InvalidAnswer as e:
             self._add(e.completions)
             raise
@@ -359,7 +364,8 @@ class BumblePlanner:
     def _write_step(self, out: Path, action: HighLevelAction) -> None:
         line = {
             "step": self.history[-1].step, "action": self.history[-1].model_dump(), "subtask": action.note,
-            "offered_frames": self.log.offered_frames, "frame": self.log.frame, "marks": self.log.marks, "buffer_frames": len(self.memory.frames),
+            "offered_frames": self.step_log.offered_frames, "frame": self.step_log.frame, "marks": self.step_log.marks,
+            "buffer_frames": len(self.memory.frames),
         }
         with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
             f.write(json.dumps(line) + "\n")
@@ -368,7 +374,6 @@ class BumblePlanner:
         for c in completions:
             self.usage.add(c)
             self.llm_seconds += c.latency_s
-            self.log.completions.append(c)
 
     def _body(self) -> Embodiment:
         if self.body is None:

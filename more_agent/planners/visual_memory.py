@@ -6,9 +6,10 @@ unexplored area (exploration). Here every rendered frame is offered to the buffe
 when the camera has moved at least ``min_move_m`` or turned at least ``min_turn_deg`` since the last
 kept frame (the initial full turn keeps every view: its turns are about 35 degrees).
 
-A kept frame holds its pose and its RGB, instance and coarse depth images compressed (a few tens of
-kB per frame); the PNG a request sends is encoded the first time the frame is sent. Which objects a frame shows is its set of instance ids; which unexplored areas it shows is
-decided when asked, against the frontiers of the current scene graph (:func:`shows_points`).
+A kept frame holds its pose and its RGB, instance and coarse depth images compressed (about 12 kB
+per frame); the PNG a request sends is encoded the first time the frame is sent. Which objects a
+frame shows is its set of instance ids; which unexplored areas it shows is decided when asked,
+against the frontiers of the current scene graph (:func:`shows_points`).
 """
 
 from __future__ import annotations
@@ -35,11 +36,15 @@ class MemoryConfig(BaseModel):
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    min_move_m: float = Field(default=0.5, gt=0, description="Keep a frame after the camera moved this far since the last kept one.")
+    min_move_m: float = Field(
+        default=0.5, gt=0, description="Keep a frame after the camera moved this far since the last kept one."
+    )
     min_turn_deg: float = Field(default=30.0, gt=0, description="... or turned this much.")
-    max_images: int = Field(default=8, ge=1, description="Most buffer frames in one VLM request (the buffer is subsampled beyond).")
+    max_images: int = Field(
+        default=8, ge=1, description="Most buffer frames in one VLM request (the buffer is subsampled beyond)."
+    )
     occlusion_margin_m: float = Field(
-        default=0.3, ge=0, description="A point counts as seen in a frame if the frame's depth there reaches within this of it."
+        default=0.3, ge=0, description="A point counts as seen in a frame if the frame's depth there reaches within this of it.",
     )
 
 

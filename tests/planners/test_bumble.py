@@ -170,3 +170,21 @@ def test_filtering_marks_only_task_objects_and_their_containers(tmp_path: Path) 
             assert {e.split(" [")[0] for e in entries} <= task_objects | holders, entries
             listed += len(entries)
     assert listed > 0
+
+
+def test_cli_runs_bumble_filter_against_a_local_server(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from typer.testing import CliRunner
+
+    from more_agent.cli import app
+
+    with BrainServer(Short()) as server:
+        env = {"OPENAI_BASE_URL": server.base_url, "OPENAI_API_KEY": "sk-test", "MORE_AGENT_LLM": "",
+               "MORE_AGENT_LLM_CONFIG": "", "MORE_AGENT_LLM_CACHE": str(tmp_path / "cache.sqlite")}
+        for name, value in env.items():
+            monkeypatch.setenv(name, value)
+        result = CliRunner().invoke(app, ["run", TASK, "--scene", str(KITCHEN), "--planner", "bumble-filter",
+                                          "--llm", "openai:fake-model", "--out", str(tmp_path / "ep")])
+    assert result.exit_code == 0, result.output
+    record = json.loads((tmp_path / "ep" / "episode.json").read_text())
+    assert record["planner"] == "bumble-filter" and record["error"] is None and record["done_called"]
+    assert record["llm_usage"]["images"] == sum(len(request_images(r.body)) for r in server.requests) > 0
