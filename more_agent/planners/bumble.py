@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -105,6 +106,16 @@ class Decision:
     """Why no target could be offered (nothing seen yet, no unexplored area in memory)."""
 
 
+@dataclass(frozen=True)
+class PastAction:
+    """An executed action as the step prompt's history shows it: 'subtask -> skill(target)'."""
+
+    name: str
+    arguments: list[str]
+    ok: bool
+    feedback: str
+
+
 @dataclass
 class StepLog:
     """What one step showed and got picked, for ``steps.jsonl``."""
@@ -131,6 +142,8 @@ class BumblePlanner:
         self.memory = VisualMemory(config.memory)
         self.task = ""
         self.history: list[ActionRecord] = []
+        self.subtasks: list[str] = []
+        """The subtask of each action in ``history``."""
         self.feedback = ""
         self.out_dir: Path | None = None
         self.graph: SceneGraph | None = None
@@ -162,7 +175,7 @@ class BumblePlanner:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
         self.task = context.instance.description
-        self.history, self.feedback = [], ""
+        self.history, self.subtasks, self.feedback = [], [], ""
         self.usage, self.llm_seconds = UsageMeter(), 0.0
         self.body.sense()
         self.body.look_around()
@@ -198,6 +211,7 @@ class BumblePlanner:
             step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
             feedback=result.feedback,
         ))
+        self.subtasks.append(action.note if action.name != INVALID else "")
         if self.out_dir is not None:
             self._write_step(self.out_dir, action)
         self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
@@ -243,10 +257,17 @@ class BumblePlanner:
         frame = self._current()
         ids = self.markable(set(np.unique(frame.instance).tolist()) - {0})
         view, marked = self.marked_picture(frame.rgb, frame.instance, ids, "Current view:")
-        held = self._graph().held_object
+        graph = self._graph()
+        xy = graph.robot.position
+        objects = [f"{self.descriptions[o]}, {math.dist(xy, graph.objects[o].position[:2]):.1f} m away" for o in marked]
+        past = [
+            PastAction(f"{subtask} -> {a.name}" if subtask else a.name, a.arguments, a.ok, a.feedback)
+            for a, subtask in zip(self.history, self.subtasks, strict=True)
+        ]
+        held = graph.held_object
         return step_messages(
-            task=self.task, view=view, objects=[self.descriptions[o] for o in marked],
-            held=held.label if held is not None else None, history=self.history, feedback=self.feedback,
+            task=self.task, view=view, objects=objects, held=held.label if held is not None else None, history=past,
+            feedback=self.feedback,
         )
 
     def _object_target(self, subtask: str) -> Decision:

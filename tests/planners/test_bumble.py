@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -166,8 +167,8 @@ def test_filtering_marks_only_task_objects_and_their_containers(tmp_path: Path) 
     for r in server.requests:
         if kind(r.body) in ("object", "plan"):
             entries = [line.split(": ", 1)[1] for line in request_text(r.body).splitlines() if line[:1].isdigit() and ": " in line]
-            holders = {e.split("[inside ", 1)[1].rstrip("]") for e in entries if "[inside " in e}
-            assert {e.split(" [")[0] for e in entries} <= task_objects | holders, entries
+            holders = {m for e in entries for m in re.findall(r"\[inside ([^\]]+)\]", e)}
+            assert {re.split(r" \[|, ", e)[0] for e in entries} <= task_objects | holders, entries
             listed += len(entries)
     assert listed > 0
 
