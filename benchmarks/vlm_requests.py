@@ -38,7 +38,7 @@ from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner  # noqa: E4
 from more_agent.planners.visual_memory import VisualMemory  # noqa: E402
 from more_agent.sim.goals import GoalChecker  # noqa: E402
 from more_agent.sim.instantiate import instantiate  # noqa: E402
-from more_agent.sim.tasks import suitable_scenes, task_set  # noqa: E402
+from prompt_tokens import ScriptedLLM, pick_task  # noqa: E402  (benchmarks/ is on the path when run as a script)
 
 DEFAULT_SCENES = ("grocery_store_convenience", "house_single_floor")
 SKILLS = ("explore", "navigate", "explore", "go_to_and_open")
@@ -49,16 +49,8 @@ def _text(messages: Sequence[ChatMessage]) -> str:
     return content if isinstance(content, str) else "\n".join(p["text"] for p in content if p["type"] == "text")
 
 
-class ScriptedVLM:
+class ScriptedVLM(ScriptedLLM):
     """An in-process LLMClient answering the BUMBLE questions by rule (module docstring)."""
-
-    def __init__(self, categories: set[str]) -> None:
-        self.categories = categories
-        self.turn = 0
-
-    @property
-    def model(self) -> str:
-        return "scripted"
 
     def complete(self, messages: Sequence[ChatMessage], *, schema: Any = None, purpose: str = "", attempt: int = 0) -> Completion:
         text = _text(messages)
@@ -94,11 +86,6 @@ class TimedMemory(VisualMemory):
             return super().offer(frame)
         finally:
             self.seconds += time.perf_counter() - t
-
-
-def pick_task(scene: str) -> str | None:
-    """The first paper task that suits ``scene``."""
-    return next((t for t in task_set("more-paper") if scene in suitable_scenes(t)), None)
 
 
 def run(scene: str, planner_name: str, steps: int, seed: int) -> dict[str, object]:

@@ -49,6 +49,7 @@ from more_agent.llm.images import png_bytes
 from more_agent.llm.prompts import filter_messages
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
 from more_agent.planners.llm_planner import INVALID, STEPS_FILE, _without_visited_frontiers, make_clients
 from more_agent.planners.policies import (
@@ -207,14 +208,10 @@ class BumblePlanner:
     def execute(self, action: HighLevelAction) -> ActionResult:
         """Run the subpolicy (explorations get the VLM's verdict as feedback); counts steps and path since the last result."""
         result = self._run(action)
-        self.history.append(ActionRecord(
-            step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback,
-        ))
+        self.feedback = append_action(self.history, action, result)
         self.subtasks.append(action.note if action.name != INVALID else "")
         if self.out_dir is not None:
             self._write_step(self.out_dir, action)
-        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
         return self._body().report(result)
 
     def observed_objects(self) -> set[str]:
@@ -392,24 +389,26 @@ class BumblePlanner:
             f.write(json.dumps(line) + "\n")
 
     def _add(self, completions: Sequence[Completion]) -> None:
+        """Count answers in this episode's usage as they arrive (an error later keeps them)."""
         for c in completions:
             self.usage.add(c)
             self.llm_seconds += c.latency_s
 
     def _body(self) -> Embodiment:
-        if self.body is None:
-            raise RuntimeError("reset() must be called before the first step")
-        return self.body
+        return _needed(self.body, "reset()")
 
     def _graph(self) -> SceneGraph:
-        if self.graph is None:
-            raise RuntimeError("observe() must be called before decide() / execute()")
-        return self.graph
+        return _needed(self.graph, "observe()")
 
     def _current(self) -> Frame:
-        if self.current is None:
-            raise RuntimeError("reset() must be called before the first step")
-        return self.current
+        return _needed(self.current, "reset()")
+
+
+def _needed(value: T | None, call: str) -> T:
+    """``value``, or a RuntimeError saying that ``call`` has to come first."""
+    if value is None:
+        raise RuntimeError(f"{call} must be called before this step of the planner")
+    return value
 
 
 def make_bumble(llm: str | None) -> BumblePlanner:

@@ -56,6 +56,7 @@ from more_agent.llm import (
 from more_agent.llm.completion import Completion
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
 from more_agent.planners.policies.skills import pick_target
@@ -217,13 +218,9 @@ class LLMPlanner:
         """Run the subpolicy; the result counts the low-level steps and path since the last result
         (so the initial full turn is part of the first step's)."""
         result = self._run(action)
-        self.history.append(ActionRecord(
-            step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback,
-        ))
+        self.feedback = append_action(self.history, action, result)
         if self.out_dir is not None:
             self._write_step(self.out_dir, self.history[-1])
-        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
         return self._body().report(result)
 
     def observed_objects(self) -> set[str]:
