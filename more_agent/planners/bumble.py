@@ -70,6 +70,9 @@ log = logging.getLogger(__name__)
 
 T = TypeVar("T")
 
+VLM_IMAGES_DIR = "vlm"
+"""Folder (in the episode folder, with ``--save-frames``) of the annotated images the VLM was shown."""
+
 OBSERVED_ROOM = "observed_objects"
 """The single 'room' of the scene text the filter gets under ``bumble-filter`` (BUMBLE has no rooms)."""
 
@@ -147,6 +150,7 @@ class BumblePlanner:
         """The subtask of each action in ``history``."""
         self.feedback = ""
         self.out_dir: Path | None = None
+        self.save_images = False
         self.graph: SceneGraph | None = None
         self.descriptions: dict[str, str] = {}
         """Object id -> how the VLM reads it ('apple A [inside fridge A]')."""
@@ -172,6 +176,7 @@ class BumblePlanner:
 
         self.body.on_frame = on_frame
         self.out_dir = context.out_dir
+        self.save_images = context.save_frames and context.out_dir is not None
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
@@ -254,6 +259,7 @@ class BumblePlanner:
         frame = self._current()
         ids = self.markable(set(np.unique(frame.instance).tolist()) - {0})
         view, marked = self.marked_picture(frame.rgb, frame.instance, ids, "Current view:")
+        self._save_image(view, "view")
         graph = self._graph()
         xy = graph.robot.position
         objects = [f"{self.descriptions[o]}, {math.dist(xy, graph.objects[o].position[:2]):.1f} m away" for o in marked]
@@ -282,6 +288,7 @@ class BumblePlanner:
         self.step_log.frame = frame.index
         picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
         self.step_log.marks = dict(enumerate(marked, start=1))
+        self._save_image(picture, "object")
         m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
                                       objects=[self.descriptions[o] for o in marked]),
                       MarkAnswer, lambda a: parse_choice(a, "mark", len(marked)), "object")
@@ -387,6 +394,13 @@ class BumblePlanner:
         }
         with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
             f.write(json.dumps(line) + "\n")
+
+    def _save_image(self, picture: Picture, kind: str) -> None:
+        """With ``--save-frames``: write an annotated image the VLM is shown as ``vlm/step_NNN_<kind>.png``."""
+        if self.save_images and self.out_dir is not None:
+            folder = self.out_dir / VLM_IMAGES_DIR
+            folder.mkdir(exist_ok=True)
+            (folder / f"step_{len(self.history):03d}_{kind}.png").write_bytes(picture.png)
 
     def _add(self, completions: Sequence[Completion]) -> None:
         """Count answers in this episode's usage as they arrive (an error later keeps them)."""

@@ -16,7 +16,7 @@ from more_agent.eval.episode import run_episode
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.llm import CacheMode, LLMConfig, make_client
 from more_agent.llm.images import LOW_DETAIL_TOKENS
-from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
+from more_agent.planners.bumble import BUMBLE_CONFIGS, VLM_IMAGES_DIR, BumblePlanner
 from more_agent.planners.llm_planner import INVALID, STEPS_FILE
 from more_agent.planners.set_of_marks import annotate_marks
 from tests.fakes.openai_server import request_images, request_text
@@ -184,8 +184,12 @@ def test_cli_runs_bumble_filter_against_a_local_server(tmp_path: Path, monkeypat
         for name, value in env.items():
             monkeypatch.setenv(name, value)
         result = CliRunner().invoke(app, ["run", TASK, "--scene", str(KITCHEN), "--planner", "bumble-filter",
-                                          "--llm", "openai:fake-model", "--out", str(tmp_path / "ep")])
+                                          "--llm", "openai:fake-model", "--out", str(tmp_path / "ep"), "--save-frames"])
     assert result.exit_code == 0, result.output
     record = json.loads((tmp_path / "ep" / "episode.json").read_text())
     assert record["planner"] == "bumble-filter" and record["error"] is None and record["done_called"]
     assert record["llm_usage"]["images"] == sum(len(request_images(r.body)) for r in server.requests) > 0
+    views = sorted((tmp_path / "ep" / VLM_IMAGES_DIR).glob("step_*_view.png"))
+    assert len(views) == record["high_level_steps"]  # the annotated view of every step decision
+    first_plan = next(r for r in server.requests if kind(r.body) == "plan")
+    assert request_images(first_plan.body) == [views[0].read_bytes()]
