@@ -12,7 +12,8 @@ the planner reasons over images instead of a scene text.
   0.5 m or 30 degrees, the initial turn included). Long-term memory: every failed action with its
   feedback; short-term: the last five actions (the history text MORE's planner gets).
 - **Deciding**: the VLM gets the task, the current view annotated set-of-mark style with its marked
-  objects listed, the memories and the skills, and answers a subtask and a skill.
+  objects listed (with their distance from the robot, as BUMBLE's selector gets them), the memories
+  (each past action with its subtask) and the skills, and answers a subtask and a skill.
 - **Reaching an object** (``navigate``, ``go_to_and_*``): the landmark step (BUMBLE's
   ``goto_landmark``) shows buffer frames with their object lists and asks for a frame; the object step
   (``navigate_to_point_on_ground``) shows that frame with numbered marks and asks for a mark.
