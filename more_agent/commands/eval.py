@@ -14,7 +14,7 @@ from more_agent.errors import UserError
 @user_errors_exit_2
 def eval_(
     tasks: Annotated[str, typer.Option(help="Task set (more-paper, behavior-rearrange), a file of names, or 'a,b,c'.")],
-    planner: Annotated[str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr.")],
+    planner: Annotated[str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr, bumble, bumble-filter.")],
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,

@@ -58,6 +58,11 @@ class LLMUsage(BaseModel):
     completion_tokens: int = 0
     cost_usd: float = 0.0
     cache_hits: int = 0
+    images: int = Field(default=0, description="Images sent (vision planners).")
+    image_bytes: int = Field(default=0, description="Bytes of the images sent (decoded PNG).")
+    image_tokens: int = Field(
+        default=0, description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server)."
+    )
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 
@@ -92,7 +97,7 @@ class EpisodeRecord(BaseModel):
     task: str = Field(description="BEHAVIOR-1K activity name.")
     scene: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(description="Seed of scene generation and task instantiation.")
-    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr'.")
+    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'.")
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
     description: str = Field(default="", description="Language description the planner received.")
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")

@@ -7,6 +7,7 @@ JSON extraction, cost and usage accounting on top of any backend.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections.abc import Mapping, Sequence
@@ -20,6 +21,7 @@ from more_agent.llm.cache import CachedAnswer, ResponseCache, request_key
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.config import CacheMode, ModelPrice
 from more_agent.llm.errors import ReplayMiss, Unparseable
+from more_agent.llm.images import cache_view, image_stats
 from more_agent.llm.jsontext import extract_json, json_schema_of
 from more_agent.llm.usage import UsageMeter, cost_usd, price_of
 
@@ -137,7 +139,7 @@ class ChatClient:
         key_fields = {
             "backend": self.backend.kind,
             "model": self.backend.model,
-            "messages": list(request.messages),
+            "messages": [cache_view(m) for m in request.messages],  # images by the hash of their bytes
             "schema": request.schema,
             "temperature": request.temperature,
             "max_tokens": request.max_tokens,
@@ -163,6 +165,7 @@ class ChatClient:
             answer, request, cached=hit is not None, attempts=attempts, purpose=purpose,
             latency_s=time.perf_counter() - start,
         )
+        completion = dataclasses.replace(completion, **dataclasses.asdict(image_stats(request.messages)))
         self.usage.add(completion)
         log.debug(
             "llm %s model=%s tokens=%d+%d cost=%.5f cached=%s latency=%.2fs attempts=%d",

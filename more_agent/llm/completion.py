@@ -10,7 +10,8 @@ class ChatMessage(TypedDict):
     """One chat message as the OpenAI chat API takes it."""
 
     role: Literal["system", "user", "assistant"]
-    content: str
+    content: str | list[dict[str, Any]]
+    """Text, or a list of content parts (text and base64 PNG ``image_url`` parts: :mod:`more_agent.llm.images`)."""
 
 
 @dataclass(frozen=True)
@@ -48,3 +49,10 @@ class Completion:
     """HTTP attempts made (0 for a cache hit)."""
     purpose: str
     """What the call was for ('plan', 'filter', 'room', ...), for logs and replay errors."""
+    images: int = 0
+    """Images in the request."""
+    image_bytes: int = 0
+    """Bytes of those images (decoded PNG)."""
+    image_tokens: int = 0
+    """Prompt tokens OpenAI bills for them (:func:`more_agent.llm.images.image_tokens`); part of ``usage.prompt_tokens``
+    when the server counts images, as OpenAI's does."""

@@ -19,6 +19,8 @@ from more_agent.llm.answers import DEFAULT_SKILLS, Skill
 from more_agent.llm.completion import ChatMessage
 
 PROMPT_NAMES = ("room", "filter", "plan")
+VLM_PROMPT_NAMES = ("bumble_plan", "bumble_landmark", "bumble_object", "bumble_explore", "bumble_verify")
+"""The BUMBLE baselines' prompts (:mod:`more_agent.planners.vlm_prompts` builds their messages with images)."""
 HISTORY_LAST_N = 5
 """The planner sees the last five actions plus all failed ones (paper Sec. III-C)."""
 
@@ -28,7 +30,7 @@ _SECTION = re.compile(r"^\[\[(system|user|assistant)\]\]\s*$", re.M)
 @functools.cache
 def load_template(name: str) -> tuple[tuple[str, Template], ...]:
     """The (role, template) sections of ``prompts/NAME.txt``."""
-    if name not in PROMPT_NAMES:
+    if name not in PROMPT_NAMES + VLM_PROMPT_NAMES:
         raise ValueError(f"unknown prompt {name!r}; prompts: {', '.join(PROMPT_NAMES)}")
     text = resources.files("more_agent.llm").joinpath("prompts", f"{name}.txt").read_text(encoding="utf-8")
     parts = _SECTION.split(text)

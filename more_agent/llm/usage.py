@@ -57,6 +57,9 @@ class UsageMeter:
     completion_tokens: int = 0
     cost_usd: float = 0.0
     cache_hits: int = 0
+    images: int = 0
+    image_bytes: int = 0
+    image_tokens: int = 0
     unpriced_models: set[str] = field(default_factory=set)
 
     def add(self, completion: Completion) -> None:
@@ -66,6 +69,9 @@ class UsageMeter:
         self.completion_tokens += completion.usage.completion_tokens
         self.cost_usd += completion.cost_usd
         self.cache_hits += int(completion.cached)
+        self.images += completion.images
+        self.image_bytes += completion.image_bytes
+        self.image_tokens += completion.image_tokens
         if not completion.cost_known:
             self.unpriced_models.add(completion.model)
 
@@ -77,4 +83,7 @@ class UsageMeter:
             "completion_tokens": self.completion_tokens,
             "cost_usd": self.cost_usd,
             "cache_hits": self.cache_hits,
+            "images": self.images,
+            "image_bytes": self.image_bytes,
+            "image_tokens": self.image_tokens,
         }

@@ -113,6 +113,8 @@ _BUILTIN: dict[str, str] = {
     "more": "more_agent.planners.llm_planner:make_more",
     "moma-llm": "more_agent.planners.llm_planner:make_moma_llm",
     "moma-llm-sr": "more_agent.planners.llm_planner:make_moma_llm_sr",
+    "bumble": "more_agent.planners.bumble:make_bumble",
+    "bumble-filter": "more_agent.planners.bumble:make_bumble_filter",
 }
 """Built-in planners: name -> 'module:attribute' of a factory, imported on first use."""
 

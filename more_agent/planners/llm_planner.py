@@ -56,6 +56,7 @@ from more_agent.llm import (
 from more_agent.llm.completion import Completion
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
 from more_agent.planners.policies.skills import pick_target
@@ -162,8 +163,6 @@ class LLMPlanner:
         self.graph: SceneGraph | None = None
         self.view: SceneView | None = None
         self.trace: StepTrace | None = None
-        self._reported_steps = 0
-        self._reported_path = 0
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
@@ -176,7 +175,6 @@ class LLMPlanner:
         self.task = context.instance.description
         self.history, self.feedback = [], ""
         self.usage, self.llm_seconds = UsageMeter(), 0.0
-        self._reported_steps, self._reported_path = 0, 1
         self.body.sense()
         self.body.look_around()
 
@@ -220,19 +218,10 @@ class LLMPlanner:
         """Run the subpolicy; the result counts the low-level steps and path since the last result
         (so the initial full turn is part of the first step's)."""
         result = self._run(action)
-        self.history.append(ActionRecord(
-            step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback,
-        ))
+        self.feedback = append_action(self.history, action, result)
         if self.out_dir is not None:
             self._write_step(self.out_dir, self.history[-1])
-        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
-        body = self._body()
-        steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
-        path = body.trajectory[self._reported_path - 1:] if len(body.trajectory) > self._reported_path else []
-        self._reported_path = len(body.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
-                            path=path, blocking=result.blocking)
+        return self._body().report(result)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""

@@ -219,3 +219,22 @@ class _Handler(BaseHTTPRequestHandler):
             return
         item = self.fake._next(RecordedRequest(self.path, {k.lower(): v for k, v in self.headers.items()}, body))
         self._serve(item, body)
+
+
+def request_text(body: dict[str, Any]) -> str:
+    """The text of a request's last message (its text parts joined when it carries images)."""
+    content = body["messages"][-1]["content"]
+    if isinstance(content, str):
+        return content
+    return "\n".join(p["text"] for p in content if p.get("type") == "text")
+
+
+def request_images(body: dict[str, Any]) -> list[bytes]:
+    """The images of a request's messages (base64 data URLs of ``image_url`` parts), decoded, in order."""
+    import base64
+
+    return [
+        base64.b64decode(p["image_url"]["url"].split(";base64,", 1)[1])
+        for m in body["messages"] if isinstance(m["content"], list)
+        for p in m["content"] if p.get("type") == "image_url"
+    ]

@@ -3,9 +3,11 @@
 
 from more_agent.planners.policies.embodiment import Embodiment, PolicyConfig
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
-from more_agent.planners.policies.skills import MANIPULATION_SKILLS, explore, go_to_and, navigate, pick_target
+from more_agent.planners.policies.skills import (
+    MANIPULATION_SKILLS, explore, explore_frontiers, go_to_and, navigate, pick_target,
+)
 
 __all__ = [
-    "MANIPULATION_SKILLS", "Embodiment", "PolicyConfig", "agent_nav_grid", "explore", "go_to_and", "navigate",
-    "object_goal", "path_to_nearest", "pick_target",
+    "MANIPULATION_SKILLS", "Embodiment", "PolicyConfig", "agent_nav_grid", "explore", "explore_frontiers", "go_to_and",
+    "navigate", "object_goal", "path_to_nearest", "pick_target",
 ]

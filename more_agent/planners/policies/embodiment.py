@@ -17,7 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
-from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
+from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult
 from more_agent.sim.motion import full_turn_angles, move_forward, turn
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame, Renderer, instance_table
@@ -69,6 +69,8 @@ class Embodiment:
         self.on_frame: Callable[[Frame], None] | None = None
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
+        self._reported_steps = 0
+        self._reported_path = 1
 
     @classmethod
     def for_episode(
@@ -158,6 +160,15 @@ class Embodiment:
                     self.sense()
         self.sense()
         return True
+
+    def report(self, result: ActionResult) -> ActionResult:
+        """``result`` with the low-level steps and path since the last report (the first report also
+        counts what came before it, such as the initial full turn)."""
+        steps, self._reported_steps = self.low_level_steps - self._reported_steps, self.low_level_steps
+        path = self.trajectory[self._reported_path - 1:] if len(self.trajectory) > self._reported_path else []
+        self._reported_path = len(self.trajectory)
+        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
+                            path=path, blocking=result.blocking)
 
     def record_jump(self, path: Sequence[XY], steps: int) -> None:
         """Account for a motion a magic action made (its path and low-level steps), then sense."""

@@ -56,9 +56,15 @@ def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY]) -> tuple[bo
 
 def explore(body: Embodiment, graph: SceneGraph, region_id: str, room: str) -> ActionResult:
     """Go to the closest frontier of a region not explored before, and look around there."""
+    return explore_frontiers(body, graph, graph.frontiers(region_id), room)
+
+
+def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[XY], room: str) -> ActionResult:
+    """Go to the closest of ``candidates`` (frontiers) not explored before, and look around there;
+    ``room`` names the area in the feedback."""
     start = body.low_level_steps
     near = body.config.visited_frontier_m
-    frontiers = [f for f in graph.frontiers(region_id) if all(math.dist(f, v) > near for v in body.visited_frontiers)]
+    frontiers = [f for f in candidates if all(math.dist(f, v) > near for v in body.visited_frontiers)]
     if not frontiers:
         return _fail(FailureReason.INVALID_TARGET, f"no frontier left in {room}")
     reached, index, why = _drive(body, graph, frontiers)

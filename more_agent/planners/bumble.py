@@ -1,0 +1,438 @@
+"""The BUMBLE baselines (paper Table I rows 1-2): a VLM planner with visual memory, with and without MORE's filter.
+
+Follows the paper's adaptation of BUMBLE (supplementary "BUMBLE Implementation"; original:
+UT-Austin-RobIn/BUMBLE): the same episode loop, subpolicies, feedback and termination as MORE, but
+the planner reasons over images instead of a scene text.
+
+- **Perception**: the renderer's ground-truth instance segmentation replaces Grounded SAM; instance
+  0 (floor, carpet, lawn, driveway, walls, windows) is background and never marked. Objects are the
+  scene graph's (its labels, states and relations describe them); the graph also gives the map the
+  subpolicies drive on and the unexplored areas (frontiers).
+- **Visual memory**: every rendered frame is offered to a :class:`VisualMemory` buffer (one frame per
+  0.5 m or 30 degrees, the initial turn included). Long-term memory: every failed action with its
+  feedback; short-term: the last five actions (the history text MORE's planner gets).
+- **Deciding**: the VLM gets the task, the current view annotated set-of-mark style with its marked
+  objects listed (with their distance from the robot, as BUMBLE's selector gets them), the memories
+  (each past action with its subtask) and the skills, and answers a subtask and a skill.
+- **Reaching an object** (``navigate``, ``go_to_and_*``): the landmark step (BUMBLE's
+  ``goto_landmark``) shows buffer frames with their object lists and asks for a frame; the object step
+  (``navigate_to_point_on_ground``) shows that frame with numbered marks and asks for a mark.
+- **Exploring**: the VLM picks one of the buffer frames that show unexplored areas; the robot explores
+  the closest area seen in it. The VLM then sees the frames acquired during the exploration and says
+  whether the subtask was achieved: that verdict is the action's success flag and feedback (so an
+  exploration that found nothing enters the long-term memory of failed actions).
+- **``bumble-filter``**: MORE's filter (its prompt and parser) on the objects the VLM could be shown;
+  only the kept objects are marked and listed, and frames are chosen to show them.
+
+Requests hold at most ``MemoryConfig.max_images`` buffer frames (8), chosen to show as many
+candidate objects as possible (greedy cover) or, for exploration verdicts, evenly spread; the step
+and object questions send one image. Invalid answers are re-asked (``max_reasks``), then become an
+``invalid`` action fed back to the next step, as for MORE.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+from collections.abc import Callable, Collection, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from more_agent.eval.record import ActionRecord, LLMUsage
+from more_agent.llm import FilterAnswer, InvalidAnswer, LLMClient, UsageMeter, ask_validated, parse_filter_answer
+from more_agent.llm.completion import ChatMessage, Completion
+from more_agent.llm.images import png_bytes
+from more_agent.llm.prompts import filter_messages
+from more_agent.mapping import MappingConfig
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.history import append_action
+from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
+from more_agent.planners.llm_planner import INVALID, STEPS_FILE, _without_visited_frontiers, make_clients
+from more_agent.planners.policies import (
+    MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore_frontiers, go_to_and, navigate,
+)
+from more_agent.planners.set_of_marks import annotate_marks
+from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
+from more_agent.planners.vlm_prompts import (
+    FrameAnswer, MarkAnswer, Picture, StepAnswer, VerifyAnswer, frame_captions, frames_messages, object_messages,
+    parse_choice, parse_step, parse_verdict, step_messages,
+)
+from more_agent.scene_graph import ObjectNode, SceneGraph
+from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.sim.navgrid import XY
+from more_agent.sim.render import Frame
+
+log = logging.getLogger(__name__)
+
+T = TypeVar("T")
+
+VLM_IMAGES_DIR = "vlm"
+"""Folder (in the episode folder, with ``--save-frames``) of the annotated images the VLM was shown."""
+
+OBSERVED_ROOM = "observed_objects"
+"""The single 'room' of the scene text the filter gets under ``bumble-filter`` (BUMBLE has no rooms)."""
+
+
+class BumbleConfig(BaseModel):
+    """What distinguishes BUMBLE from BUMBLE + filtering, and the knobs they share."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    name: str = Field(description="Planner name as registered.")
+    filtering: bool = Field(description="Mark and list only the objects MORE's filter keeps.")
+    max_reasks: int = Field(default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action.")
+    memory: MemoryConfig = Field(default_factory=MemoryConfig, description="Frame buffer and images per request.")
+    policy: PolicyConfig = Field(default_factory=PolicyConfig, description="Subpolicy knobs.")
+    mapping: MappingConfig = Field(default_factory=MappingConfig, description="Mapping and scene-graph knobs.")
+
+
+BUMBLE_CONFIGS: dict[str, BumbleConfig] = {
+    "bumble": BumbleConfig(name="bumble", filtering=False),
+    "bumble-filter": BumbleConfig(name="bumble-filter", filtering=True),
+}
+"""The paper's two BUMBLE planners by name."""
+
+
+@dataclass(frozen=True)
+class Decision:
+    """What the parameter steps resolved for the decided action."""
+
+    subtask: str = ""
+    target: str | None = None
+    """Scene-graph object id to act on (navigate / go_to_and_*)."""
+    frontiers: tuple[XY, ...] = ()
+    """Unexplored areas seen in the chosen frame (explore)."""
+    failure: str = ""
+    """Why no target could be offered (nothing seen yet, no unexplored area in memory)."""
+
+
+@dataclass(frozen=True)
+class PastAction:
+    """An executed action as the step prompt's history shows it: 'subtask -> skill(target)'."""
+
+    name: str
+    arguments: list[str]
+    ok: bool
+    feedback: str
+
+
+@dataclass
+class StepLog:
+    """What one step showed and got picked, for ``steps.jsonl``."""
+
+    offered_frames: list[int] = field(default_factory=list)
+    """Buffer indices of the frames offered in the landmark / exploration question."""
+    frame: int | None = None
+    """Buffer index of the frame the VLM picked."""
+    marks: dict[int, str] = field(default_factory=dict)
+    """Mark number -> object id of the object step's image."""
+
+
+class BumblePlanner:
+    """BUMBLE / BUMBLE + filtering: the :class:`~more_agent.planners.base.Planner` protocol over a VLM (module docstring)."""
+
+    def __init__(self, config: BumbleConfig, client: LLMClient, spec: str) -> None:
+        self.name = config.name
+        self.llm: str | None = spec
+        self.config = config
+        self.client = client
+        self.usage = UsageMeter()
+        self.llm_seconds = 0.0
+        self.body: Embodiment | None = None
+        self.memory = VisualMemory(config.memory)
+        self.task = ""
+        self.history: list[ActionRecord] = []
+        self.subtasks: list[str] = []
+        """The subtask of each action in ``history``."""
+        self.feedback = ""
+        self.out_dir: Path | None = None
+        self.save_images = False
+        self.graph: SceneGraph | None = None
+        self.descriptions: dict[str, str] = {}
+        """Object id -> how the VLM reads it ('apple A [inside fridge A]')."""
+        self.relevant: set[str] | None = None
+        """Object ids the filter kept (``bumble-filter``), None without filtering."""
+        self.current: Frame | None = None
+        """The latest rendered frame: the current view."""
+        self.decision = Decision()
+        self.step_log = StepLog()
+
+    # -- Planner protocol ---------------------------------------------------------------------
+    def reset(self, context: EpisodeContext) -> None:
+        """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer)."""
+        self.body = Embodiment.for_episode(context, config=self.config.policy, mapping=self.config.mapping)
+        self.memory = VisualMemory(self.config.memory)
+        writer = self.body.on_frame
+
+        def on_frame(frame: Frame) -> None:
+            if writer is not None:
+                writer(frame)
+            self.current = frame
+            self.memory.offer(frame)
+
+        self.body.on_frame = on_frame
+        self.out_dir = context.out_dir
+        self.save_images = context.save_frames and context.out_dir is not None
+        if self.out_dir is not None:
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+            (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
+        self.task = context.instance.description
+        self.history, self.subtasks, self.feedback = [], [], ""
+        self.usage, self.llm_seconds = UsageMeter(), 0.0
+        self.body.sense()
+        self.body.look_around()
+
+    def observe(self) -> None:
+        """Build the scene graph (map, objects, frontiers), describe its objects, filter them (``bumble-filter``)."""
+        body = self._body()
+        self.memory.step = len(self.history)
+        self.step_log = StepLog()
+        self.graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
+        view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
+        self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
+        self.relevant = self._filter(view) if self.config.filtering else None
+
+    def decide(self) -> HighLevelAction:
+        """Step decision, then the skill's parameter steps; ``invalid`` when an answer stays unusable."""
+        self.decision = Decision()
+        try:
+            skill, subtask = self._ask(self._step_messages(), StepAnswer, parse_step, "plan")
+            if skill == DONE:
+                return HighLevelAction(name=DONE, note=subtask)
+            self.decision = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
+        except InvalidAnswer as e:
+            return HighLevelAction(name=INVALID, note=e.reason)
+        target = self.decision.target
+        arguments = (self._graph().objects[target].label,) if target is not None else ()
+        return HighLevelAction(name=skill, arguments=arguments, note=subtask)
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        """Run the subpolicy (explorations get the VLM's verdict as feedback); counts steps and path since the last result."""
+        result = self._run(action)
+        self.feedback = append_action(self.history, action, result)
+        self.subtasks.append(action.note if action.name != INVALID else "")
+        if self.out_dir is not None:
+            self._write_step(self.out_dir, action)
+        return self._body().report(result)
+
+    def observed_objects(self) -> set[str]:
+        """World object names the robot has seen."""
+        return set(self.body.observed) if self.body is not None else set()
+
+    def llm_usage(self) -> LLMUsage:
+        """VLM traffic of this episode so far (images included), with the time spent waiting for answers."""
+        return LLMUsage(**self.usage.totals(), seconds=self.llm_seconds)
+
+    # -- what the VLM sees ------------------------------------------------------------------------
+    def markable(self, instance_ids: Collection[int]) -> list[str]:
+        """Object ids the VLM may be shown among ``instance_ids``, sorted by label: in the graph, not
+        held, kept by the filter under ``bumble-filter``."""
+        graph = self._graph()
+        by_instance = {o.instance_id: o for o in graph.objects.values() if not o.held and o.id in self.descriptions}
+        objs = [by_instance[i] for i in instance_ids if i in by_instance]
+        if self.relevant is not None:
+            objs = [o for o in objs if o.id in self.relevant]
+        return [o.id for o in sorted(objs, key=lambda o: o.label)]
+
+    def marked_picture(
+        self, rgb: np.ndarray, instance: np.ndarray, object_ids: Sequence[str], caption: str
+    ) -> tuple[Picture, list[str]]:
+        """The frame annotated with marks on ``object_ids``; returns the picture and the object id of each mark."""
+        graph = self._graph()
+        marked = annotate_marks(rgb, instance, [graph.objects[o].instance_id for o in object_ids])
+        by_instance = {graph.objects[o].instance_id: o for o in object_ids}
+        return Picture(caption, png_bytes(marked.rgb)), [by_instance[m.instance_id] for m in marked.marks]
+
+    def _frame_objects(self, frame: MemoryFrame) -> list[str]:
+        return [self.descriptions[o] for o in self.markable(frame.instance_ids)]
+
+    def _pictures(self, frames: Sequence[MemoryFrame]) -> list[Picture]:
+        captions = frame_captions([self._frame_objects(f) for f in frames])
+        return [Picture(c, f.png) for c, f in zip(captions, frames, strict=True)]
+
+    # -- the questions ----------------------------------------------------------------------------
+    def _step_messages(self) -> list[ChatMessage]:
+        frame = self._current()
+        ids = self.markable(set(np.unique(frame.instance).tolist()) - {0})
+        view, marked = self.marked_picture(frame.rgb, frame.instance, ids, "Current view:")
+        self._save_image(view, "view")
+        graph = self._graph()
+        xy = graph.robot.position
+        objects = [f"{self.descriptions[o]}, {math.dist(xy, graph.objects[o].position[:2]):.1f} m away" for o in marked]
+        past = [
+            PastAction(f"{subtask} -> {a.name}" if subtask else a.name, a.arguments, a.ok, a.feedback)
+            for a, subtask in zip(self.history, self.subtasks, strict=True)
+        ]
+        held = graph.held_object
+        return step_messages(
+            task=self.task, view=view, objects=objects, held=held.label if held is not None else None, history=past,
+            feedback=self.feedback,
+        )
+
+    def _object_target(self, subtask: str) -> Decision:
+        """Landmark step (which frame), then object step (which mark in it)."""
+        frames = self.memory.frames
+        wanted = {self._graph().objects[o].instance_id for o in self.markable({i for f in frames for i in f.instance_ids})}
+        offered = covering_frames(frames, wanted, self.config.memory.max_images)
+        if not offered:
+            return Decision(subtask=subtask, failure="no object to go to has been seen yet")
+        self.step_log.offered_frames = [f.index for f in offered]
+        pictures = self._pictures(offered)
+        k = self._ask(frames_messages("bumble_landmark", task=self.task, subtask=subtask, pictures=pictures),
+                      FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "landmark")
+        frame = offered[k - 1]
+        self.step_log.frame = frame.index
+        picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
+        self.step_log.marks = dict(enumerate(marked, start=1))
+        self._save_image(picture, "object")
+        m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
+                                      objects=[self.descriptions[o] for o in marked]),
+                      MarkAnswer, lambda a: parse_choice(a, "mark", len(marked)), "object")
+        return Decision(subtask=subtask, target=marked[m - 1])
+
+    def _explore_target(self, subtask: str) -> Decision:
+        """The frame whose unexplored areas to explore (among buffer frames showing some)."""
+        graph = self._graph()
+        points = np.array([f for r in graph.regions.values() for f in r.frontiers], dtype=float).reshape(-1, 2)
+        margin = self.config.memory.occlusion_margin_m
+        seen = {f.index: set(np.flatnonzero(shows_points(f, points, margin_m=margin)).tolist()) for f in self.memory.frames}
+        showing = [f for f in self.memory.frames if seen[f.index]]
+        offered = covering_frames(showing, set(range(len(points))), self.config.memory.max_images,
+                                  shown=lambda f: seen[f.index])
+        if not offered:
+            return Decision(subtask=subtask, failure="no unexplored area in view of the robot's memory")
+        self.step_log.offered_frames = [f.index for f in offered]
+        k = self._ask(frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
+                      FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "explore")
+        chosen = offered[k - 1]
+        self.step_log.frame = chosen.index
+        frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
+        return Decision(subtask=subtask, frontiers=frontiers)
+
+    def _verdict(self, subtask: str, frames: Sequence[MemoryFrame]) -> tuple[bool, str]:
+        """(achieved, feedback) of an exploration, from the VLM shown the frames acquired during it.
+        Without frames or a usable answer the exploration counts as done (its motion succeeded)."""
+        shown = spread(frames, self.config.memory.max_images)
+        if not shown:
+            return True, "explored; no new view"
+        try:
+            achieved, why = self._ask(
+                frames_messages("bumble_verify", task=self.task, subtask=subtask, pictures=self._pictures(shown)),
+                VerifyAnswer, parse_verdict, "verify",
+            )
+        except InvalidAnswer as e:
+            return True, f"explored; no verdict on the subtask ({e.reason})"
+        verdict = "subtask achieved" if achieved else "subtask not achieved"
+        return achieved, f"{verdict}: {why}" if why else verdict
+
+    def _filter(self, view: SceneView) -> set[str]:
+        """MORE's filter on every object the VLM could be shown, as one room; all kept when the answer is unusable."""
+        objects = tuple(o for r in view.rooms for o in r.objects)
+        flat = SceneView(rooms=(RoomText(OBSERVED_ROOM, "", objects, False),), robot_room=OBSERVED_ROOM,
+                         held=view.held, held_id=view.held_id)
+        every = {i for o in objects for i in o.ids}
+        if not objects:
+            return every
+        try:
+            kept = self._ask(filter_messages(self.task, flat.text()), FilterAnswer,
+                             lambda a: parse_filter_answer(a, flat.names()), "filter")
+        except InvalidAnswer as e:
+            log.info("filter answer unusable, showing every object: %s", e.reason)
+            return every
+        return {i for r in flat.filtered(kept).rooms for o in r.objects for i in o.ids}
+
+    def _ask(
+        self,
+        messages: list[ChatMessage],
+        schema: type[BaseModel],
+        validate: Callable[[str | Mapping[str, Any]], T],
+        purpose: str,
+    ) -> T:
+        """ask_validated with this planner's re-asks; every completion is counted, also when it raises."""
+        try:
+            answer = ask_validated(
+                self.client, messages, schema, validate, max_reasks=self.config.max_reasks, purpose=purpose
+            )
+        except InvalidAnswer as e:
+            self._add(e.completions)
+            raise
+        self._add(answer.completions)
+        return answer.value
+
+    # -- acting ---------------------------------------------------------------------------------
+    def _run(self, action: HighLevelAction) -> ActionResult:
+        """Dispatch one decided action to its subpolicy."""
+        if action.name == DONE:
+            return ActionResult(ok=True, reason=None, feedback="done")
+        if action.name == INVALID:
+            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
+        decision, body, graph = self.decision, self._body(), self._graph()
+        if decision.failure:
+            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=decision.failure)
+        if action.name == "explore":
+            first = len(self.memory.frames)
+            result = explore_frontiers(body, graph, decision.frontiers, "the chosen frame")
+            if not result.ok:
+                return result
+            achieved, feedback = self._verdict(decision.subtask, self.memory.since(first))
+            return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
+        target: ObjectNode = graph.objects[decision.target or ""]
+        if action.name == "navigate":
+            return navigate(body, graph, target)
+        return go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
+
+    # -- bookkeeping ----------------------------------------------------------------------------
+    def _write_step(self, out: Path, action: HighLevelAction) -> None:
+        line = {
+            "step": self.history[-1].step, "action": self.history[-1].model_dump(), "subtask": action.note,
+            "offered_frames": self.step_log.offered_frames, "frame": self.step_log.frame, "marks": self.step_log.marks,
+            "buffer_frames": len(self.memory.frames),
+        }
+        with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
+            f.write(json.dumps(line) + "\n")
+
+    def _save_image(self, picture: Picture, kind: str) -> None:
+        """With ``--save-frames``: write an annotated image the VLM is shown as ``vlm/step_NNN_<kind>.png``."""
+        if self.save_images and self.out_dir is not None:
+            folder = self.out_dir / VLM_IMAGES_DIR
+            folder.mkdir(exist_ok=True)
+            (folder / f"step_{len(self.history):03d}_{kind}.png").write_bytes(picture.png)
+
+    def _add(self, completions: Sequence[Completion]) -> None:
+        """Count answers in this episode's usage as they arrive (an error later keeps them)."""
+        for c in completions:
+            self.usage.add(c)
+            self.llm_seconds += c.latency_s
+
+    def _body(self) -> Embodiment:
+        return _needed(self.body, "reset()")
+
+    def _graph(self) -> SceneGraph:
+        return _needed(self.graph, "observe()")
+
+    def _current(self) -> Frame:
+        return _needed(self.current, "reset()")
+
+
+def _needed(value: T | None, call: str) -> T:
+    """``value``, or a RuntimeError saying that ``call`` has to come first."""
+    if value is None:
+        raise RuntimeError(f"{call} must be called before this step of the planner")
+    return value
+
+
+def make_bumble(llm: str | None) -> BumblePlanner:
+    """Registry factory of ``bumble``."""
+    clients = make_clients(llm)
+    return BumblePlanner(BUMBLE_CONFIGS["bumble"], clients.plan, clients.spec)
+
+
+def make_bumble_filter(llm: str | None) -> BumblePlanner:
+    """Registry factory of ``bumble-filter``."""
+    clients = make_clients(llm)
+    return BumblePlanner(BUMBLE_CONFIGS["bumble-filter"], clients.plan, clients.spec)

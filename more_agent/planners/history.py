@@ -1,0 +1,16 @@
+"""The action history the LLM and VLM planners keep: one record per executed action, and the feedback line."""
+
+from __future__ import annotations
+
+from more_agent.eval.record import ActionRecord
+from more_agent.planners.base import HighLevelAction
+from more_agent.sim.actions import ActionResult
+
+
+def append_action(history: list[ActionRecord], action: HighLevelAction, result: ActionResult) -> str:
+    """Append the executed ``action`` and its outcome to ``history``; returns the feedback line the
+    next prompt shows (``skill: success|failure; reason``)."""
+    history.append(ActionRecord(
+        step=len(history), name=action.name, arguments=list(action.arguments), ok=result.ok, feedback=result.feedback,
+    ))
+    return f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
