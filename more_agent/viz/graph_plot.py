@@ -79,21 +79,13 @@ GRAPHS_DIR = "graphs"
 
 def save_occupancy(path: str | Path, occupancy: OccupancyMap) -> Path:
     """The occupancy grid as a lossless greyscale PNG of its cell values (row 0 = lowest y), with its
-    origin and resolution in the PNG's text chunks; a few kB, read back by :func:`load_occupancy`."""
+    origin and resolution in the PNG's text chunks; a few kB, read by the episode viewer."""
     path = Path(path)
     info = PngInfo()
     info.add_text("origin_xy", json.dumps(list(occupancy.origin_xy)))
     info.add_text("resolution_m", repr(occupancy.resolution_m))
     Image.fromarray(np.ascontiguousarray(occupancy.grid.T.astype(np.uint8))).save(path, pnginfo=info)
     return path
-
-
-def load_occupancy(path: str | Path) -> OccupancyMap:
-    """The grid written by :func:`save_occupancy`."""
-    with Image.open(path) as im:
-        grid = np.asarray(im).T.astype(np.int64)
-        text = im.text  # type: ignore[attr-defined]
-    return OccupancyMap(grid=grid, origin_xy=tuple(json.loads(text["origin_xy"])), resolution_m=float(text["resolution_m"]))
 
 
 def save_step_graph(out_dir: str | Path, step: int, graph: SceneGraph, *, picture: bool = True) -> Path:

@@ -48,20 +48,20 @@ def plot_metrics(records: Sequence[EpisodeRecord], path: Path) -> Path:
     """One panel per metric: a bar per system at its mean with the 95% interval as error bar."""
     systems = by_system(records)
     names = list(systems)
-    fig, axes = plt.subplots(1, len(METRIC_NAMES), figsize=(3.2 * len(METRIC_NAMES), 0.5 + 0.45 * len(names) + 1.2), sharey=True)
+    fig, axes = plt.subplots(2, 2, figsize=(9, 2 * (0.9 + 0.4 * len(names)) + 0.6), sharey=True, constrained_layout=True)
     y = np.arange(len(names))
-    for ax, metric in zip(axes, METRIC_NAMES):
+    for ax, metric in zip(axes.flat, METRIC_NAMES):
         est = [getattr(systems[n], metric) for n in names]
         mean = np.array([100 * e.mean for e in est])
         err = np.array([[100 * (e.mean - e.low) for e in est], [100 * (e.high - e.mean) for e in est]])
         ax.barh(y, mean, xerr=err, color=[_COLOURS(i % 10) for i in range(len(names))], capsize=3, alpha=0.85)
-        for yi, m in zip(y, mean):
-            ax.text(min(m + 2, 96), yi, f"{m:.0f}", va="center", fontsize=8)
+        for yi, m, e in zip(y, mean, est):
+            ax.text(min(100 * e.high + 1.5, 92), yi, f"{m:.0f}", va="center", fontsize=8)
         ax.set_xlim(0, 100)
         ax.set_title(f"{metric} [%]", fontsize=10)
         ax.grid(axis="x", alpha=0.3)
-    axes[0].set_yticks(y, [f"{n} (n={systems[n].n})" for n in names], fontsize=8)
-    axes[0].invert_yaxis()
+        ax.set_yticks(y, [f"{n} (n={systems[n].n})" for n in names], fontsize=8)
+    axes[0, 0].invert_yaxis()
     fig.suptitle("Means with 95% intervals (Wilson for SR/TTC, bootstrap for TP/rTP)", fontsize=9)
     return _save(fig, path)
 
@@ -74,7 +74,7 @@ def plot_task_heatmap(records: Sequence[EpisodeRecord], path: Path) -> Path:
     sr = np.full((len(tasks), len(systems)), np.nan)
     for (system, task), s in cells.items():
         sr[tasks.index(task), systems.index(system)] = 100 * s.SR.mean
-    fig, ax = plt.subplots(figsize=(2.2 + 1.1 * len(systems), 1.2 + 0.2 * len(tasks)))
+    fig, ax = plt.subplots(figsize=(4.0 + 1.0 * len(systems), 1.6 + 0.2 * len(tasks)))
     im = ax.imshow(np.ma.masked_invalid(sr), cmap="RdYlGn", vmin=0, vmax=100, aspect="auto", interpolation="nearest")
     ax.set_xticks(range(len(systems)), systems, rotation=30, ha="right", fontsize=8)
     ax.set_yticks(range(len(tasks)), tasks, fontsize=7)
@@ -82,7 +82,7 @@ def plot_task_heatmap(records: Sequence[EpisodeRecord], path: Path) -> Path:
     ax.tick_params(axis="x", labeltop=True, labelbottom=False)
     plt.setp(ax.get_xticklabels(), rotation=30, ha="left")
     fig.colorbar(im, ax=ax, label="SR [%]", shrink=min(1.0, 8 / max(len(tasks), 1)) if len(tasks) > 8 else 1.0)
-    ax.set_title("Success rate per task", fontsize=10, pad=40 if systems else 6)
+    ax.set_title("Success rate per task", fontsize=10, pad=60)
     return _save(fig, path)
 
 

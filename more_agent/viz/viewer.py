@@ -34,15 +34,15 @@ FRAMES_PER_STEP = 3
 FRAME_PX = 128
 """Width and height of the embedded frames, in pixels (the camera renders 256 x 256)."""
 
-_OCC_RGBA = np.array([[0, 0, 0, 0], [255, 255, 255, 255], [64, 64, 64, 255]], dtype=np.uint8)
-"""Occupancy cell value (unknown, free, occupied) -> colour on the map."""
+_OCC_PALETTE = [0, 0, 0, 255, 255, 255, 64, 64, 64]
+"""Occupancy cell value (unknown: transparent, free, occupied) -> colour on the map."""
 _ITEM = re.compile(r",\s(?![^\[]*\])")
 """Separator of the objects on a scene-text line: a comma outside square brackets."""
 
 
 def _data_uri(image: Image.Image, fmt: str) -> str:
     buf = io.BytesIO()
-    image.save(buf, format=fmt, **({"quality": 80} if fmt == "JPEG" else {"optimize": False}))
+    image.save(buf, format=fmt, **({"quality": 80} if fmt == "JPEG" else {"compress_level": 1}))
     return f"data:image/{fmt.lower()};base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
@@ -67,17 +67,19 @@ def step_frame_indices(first: int, end: int, k: int = FRAMES_PER_STEP) -> list[i
 
 
 def _occupancy_uri(path: Path) -> tuple[str, list[float]] | None:
-    """The occupancy grid coloured (north up) as a PNG data URI, and its extent [x0, y0, x1, y1]."""
-    from more_agent.viz.graph_plot import load_occupancy
-
+    """The occupancy grid of :func:`~more_agent.viz.graph_plot.save_occupancy` coloured (north up) as a
+    palette PNG data URI, and its extent [x0, y0, x1, y1] in metres."""
     if not path.is_file():
         return None
-    occ = load_occupancy(path)
-    rgba = _OCC_RGBA[np.clip(occ.grid, 0, 2)].transpose(1, 0, 2)[::-1]  # (ny, nx): row 0 = highest y
-    nx_, ny_ = occ.grid.shape
-    x0, y0 = occ.origin_xy
-    extent = [x0, y0, x0 + nx_ * occ.resolution_m, y0 + ny_ * occ.resolution_m]
-    return _data_uri(Image.fromarray(np.ascontiguousarray(rgba), "RGBA"), "PNG"), [round(v, 3) for v in extent]
+    with Image.open(path) as im:
+        origin, res = json.loads(im.text["origin_xy"]), float(im.text["resolution_m"])  # type: ignore[attr-defined]
+        width, height = im.size  # the file's rows run along y from the lowest
+        picture = im.transpose(Image.Transpose.FLIP_TOP_BOTTOM)
+    picture.putpalette(_OCC_PALETTE)
+    extent = [origin[0], origin[1], origin[0] + width * res, origin[1] + height * res]
+    buf = io.BytesIO()
+    picture.save(buf, format="PNG", transparency=0)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), [round(v, 3) for v in extent]
 
 
 def _map(graph_json: Path) -> dict[str, Any] | None:
