@@ -30,14 +30,13 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from more_agent.eval.episode import run_episode  # noqa: E402
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec, Failure, LLMUsage  # noqa: E402
 from more_agent.eval.report import SourcedRecord, write_reports  # noqa: E402
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname  # noqa: E402
 from more_agent.llm import LLMConfig, make_client  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402
 from more_agent.sim.tasks import task_set  # noqa: E402
-from more_agent.viz.viewer import VIEWER_FILE, write_viewer  # noqa: E402
+from more_agent.viz.viewer import VIEWER_FILE, run_episode_with_viewer, write_viewer  # noqa: E402
 from tests.planners.brain import BrainServer, parse_prompt, plan  # noqa: E402
 
 TASK = "putting_shopping_away"
@@ -63,7 +62,7 @@ def fifty_step_episode(out: Path, scene: str) -> EpisodeRecord:
         client = make_client("openai:scripted", config)
         planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, "openai:scripted"))
         spec = EpisodeSpec(task=TASK, scene=scene, seed=0, planner="more", llm="openai:scripted")
-        return run_episode(spec, planner=planner, out_dir=out, viewer=True)
+        return run_episode_with_viewer(spec, planner=planner, out_dir=out)
 
 
 def comparison_runs(root: Path, record: EpisodeRecord, episode_dir: Path) -> list[SourcedRecord]:

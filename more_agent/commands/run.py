@@ -71,6 +71,7 @@ def run(
 ) -> None:
     """Run one episode of TASK and write its record and map."""
     from more_agent.eval.episode import run_episode
+    from more_agent.viz.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
 
     from more_agent.sim.tasks import load_task
@@ -84,9 +85,8 @@ def run(
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm)
     with console.status(f"running {task} with planner {planner} ..."):
-        record = run_episode(
+        record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
-            viewer=viewer,
         )
     console.print(summary_table(record, out_dir))
     if record.traceback:

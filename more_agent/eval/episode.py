@@ -93,8 +93,9 @@ def run_episode(
     task that cannot be instantiated in the scene, no LLM configured) instead of recording it: the
     CLI turns those into exit status 2. An LLM error (timeout after the retries, server gone, a
     replay miss) ends the episode with ``record.error`` naming it, everything so far kept.
-    ``viewer`` (with ``out_dir``) saves frames and scene graphs (without the per-step graph pictures
-    unless ``save_graph`` asks for them) and writes ``viewer.html`` after the record.
+    ``viewer`` (with ``out_dir``) saves what the episode viewer reads: frames and scene graphs, without
+    the slow per-step graph pictures unless ``save_graph`` asks for them
+    (``more_agent.viz.viewer.run_episode_with_viewer`` then writes the page).
     """
     from more_agent.llm.errors import LLMError
     from more_agent.sim.goals import GoalChecker
@@ -141,24 +142,7 @@ def run_episode(
         record.timings["llm"] = round(record.llm_usage.seconds, 6)
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
-        if viewer:
-            _write_viewer(Path(out_dir))
     return record
-
-
-def run_episode_with_viewer(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
-    """:func:`run_episode` that also writes the episode viewer (``more-agent eval --viewer``)."""
-    return run_episode(spec, out_dir=out_dir, viewer=True)
-
-
-def _write_viewer(out_dir: Path) -> None:
-    """Write the episode viewer; a failure is logged and never costs the record."""
-    from more_agent.viz.viewer import write_viewer
-
-    try:
-        write_viewer(out_dir)
-    except Exception as e:  # noqa: BLE001 - a failed page must not lose the record or change its outcome
-        log.warning("could not write the viewer of %s: %s: %s", out_dir, type(e).__name__, e)
 
 
 def _run_steps(

@@ -16,6 +16,7 @@ from __future__ import annotations
 import base64
 import io
 import json
+import logging
 import re
 from html import escape
 from importlib.resources import files
@@ -26,7 +27,10 @@ import numpy as np
 from PIL import Image
 
 from more_agent.errors import UserError
-from more_agent.eval.record import EpisodeRecord
+from more_agent.eval.episode import EPISODE_FILE, run_episode
+from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+
+log = logging.getLogger(__name__)
 
 VIEWER_FILE = "viewer.html"
 FRAMES_PER_STEP = 3
@@ -158,7 +162,6 @@ def _llm_step(line: dict[str, Any] | None) -> dict[str, Any]:
 def viewer_data(episode_dir: Path) -> dict[str, Any]:
     """Everything the page shows, as one JSON-ready dict."""
     episode_dir = Path(episode_dir)
-    from more_agent.eval.episode import EPISODE_FILE
     from more_agent.eval.timeline import TIMELINE_FILE
     from more_agent.planners.llm_planner import STEPS_FILE
     from more_agent.viz.frames import FRAMES_DIR
@@ -215,3 +218,15 @@ def write_viewer(episode_dir: Path, out: Path | None = None) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(html, encoding="utf-8")
     return out
+
+
+def run_episode_with_viewer(spec: EpisodeSpec, *, out_dir: Path | None = None, **kwargs: Any) -> EpisodeRecord:
+    """:func:`~more_agent.eval.episode.run_episode` with ``viewer=True``, then ``out_dir/viewer.html``
+    (``run --viewer``, ``eval --viewer``); a page that cannot be written is logged, never costs the record."""
+    record = run_episode(spec, out_dir=out_dir, viewer=True, **kwargs)
+    if out_dir is not None:
+        try:
+            write_viewer(Path(out_dir))
+        except Exception as e:  # noqa: BLE001 - a failed page must not lose the record or change its outcome
+            log.warning("could not write the viewer of %s: %s: %s", out_dir, type(e).__name__, e)
+    return record

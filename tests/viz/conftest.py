@@ -10,10 +10,10 @@ from typing import Any
 
 import pytest
 
-from more_agent.eval.episode import run_episode
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.llm import LLMConfig, make_client
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
+from more_agent.viz.viewer import run_episode_with_viewer
 from tests.planners.brain import BrainServer, plan
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
@@ -57,7 +57,7 @@ def llm_episode(tmp_path_factory: pytest.TempPathFactory) -> Episode:
                            cache_path=root / "cache.sqlite")
         client = make_client("openai:fake-model", config)
         planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, "openai:fake-model"))
-        record = run_episode(spec, planner=planner, out_dir=root / "ep", viewer=True)
+        record = run_episode_with_viewer(spec, planner=planner, out_dir=root / "ep")
         requests = [r.body for r in server.requests]
     return Episode(root / "ep", record, requests)
 
@@ -65,5 +65,5 @@ def llm_episode(tmp_path_factory: pytest.TempPathFactory) -> Episode:
 @pytest.fixture(scope="session")
 def oracle_episode(tmp_path_factory: pytest.TempPathFactory) -> Episode:
     root = tmp_path_factory.mktemp("oracle_episode")
-    record = run_episode(EpisodeSpec(task=TASK, scene=str(KITCHEN), seed=0), out_dir=root / "ep", viewer=True)
+    record = run_episode_with_viewer(EpisodeSpec(task=TASK, scene=str(KITCHEN), seed=0), out_dir=root / "ep")
     return Episode(root / "ep", record, [])

@@ -93,3 +93,28 @@ def test_view_command_writes_the_page_and_refuses_other_folders(oracle_episode: 
     assert out.read_text().startswith("<!DOCTYPE html>")
     bad = CliRunner().invoke(app, ["view", str(tmp_path)])
     assert bad.exit_code == 2 and "episode folder (no episode.json)" in " ".join(bad.output.split())
+
+
+def test_run_and_eval_take_viewer(tmp_path: Path) -> None:
+    from tests.viz.conftest import KITCHEN, TASK
+
+    out = tmp_path / "ep"
+    result = CliRunner().invoke(app, ["run", TASK, "--scene", str(KITCHEN), "--out", str(out), "--viewer"])
+    assert result.exit_code == 0, result.output
+    assert (out / VIEWER_FILE).is_file() and (out / "frames").is_dir()
+    both = ["eval", "--tasks", TASK, "--planner", "oracle", "--out", str(tmp_path / "r"), "--viewer",
+            "--episode-fn", "tests.eval.fake_episodes:deterministic_episode"]
+    refused = CliRunner().invoke(app, both)
+    assert refused.exit_code == 2 and "--episode-fn" in refused.output
+
+
+def test_an_episode_folder_with_only_its_record_still_opens(tmp_path: Path) -> None:
+    from more_agent.eval.record import ActionRecord, EpisodeRecord
+
+    record = EpisodeRecord(task="t", scene="s", seed=0, planner="oracle", trajectory=[(0.0, 0.0), (1.0, 1.0)],
+                           actions=[ActionRecord(step=0, name="navigate", arguments=["x"], ok=False, feedback=EVIL)],
+                           high_level_steps=1, error="step limit of 50 high-level steps reached")
+    (tmp_path / "episode.json").write_text(record.model_dump_json())
+    step = viewer_data(tmp_path)["steps"][0]
+    assert step["action"]["feedback"] == EVIL and step["map"] is None and step["frames"] == [] and step["goals"] is None
+    assert "<b id" not in render_viewer(viewer_data(tmp_path))
