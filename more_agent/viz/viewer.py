@@ -140,11 +140,38 @@ def _read_jsonl(path: Path) -> list[dict[str, Any]]:
     return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
 
 
+def _thumbnail(url: str) -> str:
+    """An image data URI of a VLM request shrunk to a ``FRAME_PX`` JPEG thumbnail; '' if it is not one."""
+    head, sep, data = url.partition(";base64,")
+    if not (sep and head.startswith("data:image/")):
+        return ""
+    try:
+        with Image.open(io.BytesIO(base64.b64decode(data))) as im:
+            im.thumbnail((FRAME_PX, FRAME_PX))
+            return _data_uri(im.convert("RGB"), "JPEG")
+    except (OSError, ValueError):
+        return ""
+
+
+def _with_thumbnails(exchange: dict[str, Any]) -> dict[str, Any]:
+    """The exchange with the images of its messages (VLM requests) as thumbnails, so pages stay small."""
+    messages = []
+    for m in exchange["messages"]:
+        if isinstance(m.get("content"), list):
+            m = {**m, "content": [
+                {**p, "image_url": {"url": _thumbnail(p.get("image_url", {}).get("url", ""))}}
+                if p.get("type") == "image_url" else p
+                for p in m["content"]
+            ]}
+        messages.append(m)
+    return {**exchange, "messages": messages}
+
+
 def _llm_step(line: dict[str, Any] | None) -> dict[str, Any]:
     """The planner's part of a step (scene texts, exchanges, token and latency sums); {} without one."""
     if not line:
         return {}
-    exchanges = line.get("exchanges") or []
+    exchanges = [_with_thumbnails(x) for x in line.get("exchanges") or []]
     out: dict[str, Any] = {
         "exchanges": exchanges,
         "tokens": sum(e["prompt_tokens"] + e["completion_tokens"] for e in exchanges),

@@ -118,3 +118,31 @@ def test_an_episode_folder_with_only_its_record_still_opens(tmp_path: Path) -> N
     step = viewer_data(tmp_path)["steps"][0]
     assert step["action"]["feedback"] == EVIL and step["map"] is None and step["frames"] == [] and step["goals"] is None
     assert "<b id" not in render_viewer(viewer_data(tmp_path))
+
+
+def test_images_of_vlm_requests_become_small_thumbnails(tmp_path: Path) -> None:
+    import base64
+    import io
+
+    from PIL import Image
+
+    from more_agent.eval.record import ActionRecord, EpisodeRecord
+
+    buf = io.BytesIO()
+    Image.new("RGB", (512, 512), (200, 30, 30)).save(buf, format="PNG")
+    image = "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
+    record = EpisodeRecord(task="t", scene="s", seed=0, planner="bumble", llm="openai:m", high_level_steps=1,
+                           actions=[ActionRecord(step=0, name="done", ok=True)])
+    (tmp_path / "episode.json").write_text(record.model_dump_json())
+    content = [{"type": "text", "text": "which object?"}, {"type": "image_url", "image_url": {"url": image}},
+               {"type": "image_url", "image_url": {"url": "https://example.com/x.png"}}]
+    exchange = {"purpose": "plan", "model": "m", "messages": [{"role": "user", "content": content}], "answer": EVIL,
+                "prompt_tokens": 1, "completion_tokens": 1, "latency_s": 0.1, "cached": False}
+    (tmp_path / STEPS_FILE).write_text(json.dumps({"step": 0, "exchanges": [exchange]}) + "\n")
+    parts = viewer_data(tmp_path)["steps"][0]["exchanges"][0]["messages"][0]["content"]
+    assert parts[0] == content[0]
+    thumb = parts[1]["image_url"]["url"]
+    assert thumb.startswith("data:image/jpeg;base64,")
+    with Image.open(io.BytesIO(base64.b64decode(thumb.split(",", 1)[1]))) as im:
+        assert im.size == (128, 128)
+    assert parts[2]["image_url"]["url"] == ""  # never a remote address in the page
