@@ -122,8 +122,12 @@ def scene_segments(full: str, kept: str) -> list[list[list[Any]]]:
     for line in kept.splitlines():
         head, _, body = line.partition(": ")
         kept_lines[head] = set(_ITEM.split(body)) if body else set()
+    verbatim = set(kept.splitlines())
     out = []
     for line in full.splitlines():
+        if line in verbatim:
+            out.append([[line, True]])
+            continue
         head, sep, body = line.partition(": ")
         room_kept = head in kept_lines
         pieces: list[list[Any]] = [[head + sep, room_kept]]

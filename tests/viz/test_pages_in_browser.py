@@ -32,6 +32,7 @@ def test_viewer_steps_with_the_arrow_keys_and_shows_llm_text_as_text(browser: Ch
     assert first_prompt in page.js("document.getElementById('exchanges').textContent")
     page.press(*ARROW_RIGHT)
     assert page.js("document.getElementById('counter').textContent") == f"step 2 / {n}"
+    assert "plan (re-ask 1)" in page.js("document.getElementById('exchanges').textContent")  # after the unparseable answer
     page.press(*ARROW_LEFT)
     page.press(*ARROW_LEFT)  # stays on the first step
     assert page.js("document.getElementById('counter').textContent") == f"step 1 / {n}"

@@ -70,14 +70,15 @@ def test_page_cannot_be_broken_out_of(llm_episode: Episode) -> None:
 
 
 def test_scene_segments_grey_out_what_the_filter_removed() -> None:
-    full = "kitchen_0: fridge A [open, empty], apple A [inside fridge A], table A\nbedroom_0: bed A"
-    kept = "kitchen_0: fridge A [open, empty], apple A [inside fridge A]"
+    full = "kitchen_0: fridge A [open, empty], apple A [inside fridge A], table A\nbedroom_0: bed A\nhall_0 (unexplored)"
+    kept = "kitchen_0: fridge A [open, empty], apple A [inside fridge A]\nhall_0 (unexplored)"
     lines = scene_segments(full, kept)
     assert ["".join(t for t, _ in line) for line in lines] == full.splitlines()
     assert [(t, k) for t, k in lines[0]] == [
         ("kitchen_0: ", True), ("fridge A [open, empty], ", True), ("apple A [inside fridge A], ", True), ("table A", False),
     ]
     assert all(not k for _, k in lines[1])
+    assert lines[2] == [["hall_0 (unexplored)", True]]
 
 
 def test_frames_of_a_step_are_spread_and_end_with_its_last() -> None:
