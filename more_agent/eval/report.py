@@ -1,4 +1,5 @@
-"""Reports of evaluation runs: Table I (summary.md), per-task tables, summary.csv, report.html; merging runs.
+"""Reports of evaluation runs: Table I (summary.md), per-task tables, summary.csv, report.html, the
+comparison plots (``more_agent.viz.report_plots``); merging runs.
 
 Rows of Table I are systems (planner, plus LLM when there is one); every cell is the mean in percent
 with its 95% interval; n and the number of errored episodes are their own columns.
