@@ -53,6 +53,10 @@ class RecordingClient:
         """The wrapped client's model."""
         return self.inner.model
 
+    def __getattr__(self, name: str) -> Any:
+        """Anything else (a cache, a backend) is the wrapped client's, so the wrapper stays transparent."""
+        return getattr(self.inner, name)
+
     def complete(
         self,
         messages: Sequence[ChatMessage],

@@ -6,6 +6,7 @@ import json
 import re
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from more_agent.cli import app
@@ -147,3 +148,26 @@ def test_images_of_vlm_requests_become_small_thumbnails(tmp_path: Path) -> None:
     with Image.open(io.BytesIO(base64.b64decode(thumb.split(",", 1)[1]))) as im:
         assert im.size == (128, 128)
     assert parts[2]["image_url"]["url"] == ""  # never a remote address in the page
+
+
+def test_recording_client_is_transparent_and_records_unparseable_answers() -> None:
+    from more_agent.llm.completion import Completion, TokenUsage
+    from more_agent.llm.errors import Unparseable
+    from more_agent.planners.exchanges import Exchange, RecordingClient
+
+    answer = Completion(text="no json", parsed=None, model="m", usage=TokenUsage(3, 4), cost_usd=0.0, cost_known=False,
+                        cached=True, latency_s=0.01, attempts=0, purpose="plan")
+
+    class Inner:
+        model = "m"
+        cache = "the cache"
+
+        def complete(self, messages, *, schema=None, purpose="", attempt=0):  # noqa: ANN001, ANN202
+            raise Unparseable("no JSON", completion=answer)
+
+    log: list[Exchange] = []
+    client = RecordingClient(Inner(), log)
+    assert client.model == "m" and client.cache == "the cache"
+    with pytest.raises(Unparseable):
+        client.complete([{"role": "user", "content": "hi"}], purpose="plan")
+    assert [x.to_json()["answer"] for x in log] == ["no json"] and log[0].to_json()["cached"] is True
