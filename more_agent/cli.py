@@ -1,4 +1,4 @@
-"""The ``more-agent`` command: ``run | eval | tasks | scene | report``.
+"""The ``more-agent`` command: ``run | eval | tasks | scene | report | view``.
 
 Each command group lives in ``more_agent.commands.<name>``; this module only assembles them and
 turns a ``UserError`` into one message and exit status 2, never a traceback.
@@ -13,6 +13,7 @@ from more_agent.commands import report as report_cmd
 from more_agent.commands import run as run_cmd
 from more_agent.commands import scene as scene_cmd
 from more_agent.commands import tasks as tasks_cmd
+from more_agent.commands import view as view_cmd
 
 app = typer.Typer(
     name="more-agent",
@@ -24,5 +25,6 @@ app = typer.Typer(
 app.command("run")(run_cmd.run)
 app.command("eval")(eval_cmd.eval_)
 app.command("report")(report_cmd.report)
+app.command("view")(view_cmd.view)
 app.add_typer(tasks_cmd.app, name="tasks")
 app.add_typer(scene_cmd.app, name="scene")

@@ -30,17 +30,24 @@ def eval_(
     max_retries: Annotated[int, typer.Option(min=0, help="Re-runs of an episode whose worker died.")] = 2,
     episode_fn: Annotated[str | None, typer.Option(help="Episode function 'module:function' (advanced).")] = None,
     progress: Annotated[bool, typer.Option(help="Show the progress bar.")] = True,
+    viewer: Annotated[
+        bool, typer.Option("--viewer", help="Save frames and maps and write each episode's viewer.html (linked from report.html).")
+    ] = False,
 ) -> None:
     """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl."""
     from more_agent import __version__
-    from more_agent.eval.harness import DEFAULT_EPISODE_FN, check_task_names, evaluate, resolve_tasks
+    from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
     from more_agent.eval.report import load_runs, table_i_markdown, write_reports
     from more_agent.eval.store import RunConfig, redact
 
+    if viewer and episode_fn is not None:
+        raise UserError("--viewer runs its own episode function: give either --viewer or --episode-fn")
+    if viewer:
+        episode_fn = VIEWER_EPISODE_FN
     if llm is not None and llm != redact(llm):
         raise UserError("--llm must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
     names = resolve_tasks(tasks)
-    if episode_fn is None:  # the real episode function runs BEHAVIOR-1K activities: check the names now
+    if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check the names now
         check_task_names(names)
     config = RunConfig(
         planner=planner,

@@ -14,7 +14,7 @@ from more_agent.commands._common import err_console, user_errors_exit_2
 def report(
     run_dirs: Annotated[list[Path], typer.Argument(help="Run directories written by 'more-agent eval'.")],
     out: Annotated[
-        Path | None, typer.Option(help="Also write summary.md, summary.csv and report.html here.")
+        Path | None, typer.Option(help="Also write summary.md, summary.csv, report.html and the comparison plots (PNG) here.")
     ] = None,
     per_task: Annotated[bool, typer.Option(help="Print the per-task table too.")] = False,
 ) -> None:

@@ -52,7 +52,8 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
     if record.error:
         table.add_row("why", record.error)
-    table.add_row("files", f"{out_dir / 'episode.json'}, {out_dir / 'map.png'}")
+    files = [out_dir / "episode.json", out_dir / "map.png"] + [p for p in [out_dir / "viewer.html"] if p.is_file()]
+    table.add_row("files", ", ".join(map(str, files)))
     return table
 
 
@@ -66,9 +67,11 @@ def run(
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
     llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
+    viewer: Annotated[bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")] = False,
 ) -> None:
     """Run one episode of TASK and write its record and map."""
     from more_agent.eval.episode import run_episode
+    from more_agent.viz.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
 
     from more_agent.sim.tasks import load_task
@@ -82,7 +85,7 @@ def run(
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm)
     with console.status(f"running {task} with planner {planner} ..."):
-        record = run_episode(
+        record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
         )
     console.print(summary_table(record, out_dir))

@@ -5,7 +5,8 @@
 oracle and the LLM planners alike, runs through this one loop. Termination follows the paper
 (Sec. III-D): the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
 more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
-``episode.json`` and ``map.png`` (the plan with the robot's path). Timings are seconds per phase:
+``episode.json``, ``map.png`` (the plan with the robot's path) and ``timeline.jsonl`` (per-step
+goal status and path length, for the episode viewer). Timings are seconds per phase:
 instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
 answers, part of plan) for LLM planners. Everything else in the record
 is a function of (task, scene, seed, planner, llm).
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
+from more_agent.eval.timeline import TimelineWriter
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.sim.navgrid import XY
 
@@ -82,6 +84,7 @@ def run_episode(
     save_graph: bool = False,
     strict: bool = False,
     planner: Planner | None = None,
+    viewer: bool = False,
 ) -> EpisodeRecord:
     """Run one episode of ``spec`` and return its record (also written under ``out_dir`` when given).
 
@@ -90,6 +93,9 @@ def run_episode(
     task that cannot be instantiated in the scene, no LLM configured) instead of recording it: the
     CLI turns those into exit status 2. An LLM error (timeout after the retries, server gone, a
     replay miss) ends the episode with ``record.error`` naming it, everything so far kept.
+    ``viewer`` (with ``out_dir``) saves what the episode viewer reads: frames and scene graphs, without
+    the slow per-step graph pictures unless ``save_graph`` asks for them
+    (``more_agent.viz.viewer.run_episode_with_viewer`` then writes the page).
     """
     from more_agent.llm.errors import LLMError
     from more_agent.sim.goals import GoalChecker
@@ -111,11 +117,11 @@ def run_episode(
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=planner.llm, out_dir=out_dir, save_frames=save_frames,
-            save_graph=save_graph,
+            instance=instance, goals=goals, llm=planner.llm, out_dir=out_dir, save_frames=save_frames or viewer,
+            save_graph=save_graph or viewer, graph_pictures=save_graph or not viewer,
         ))
         clock.add("sense", t)
-        _run_steps(record, planner, goals, world, clock)
+        _run_steps(record, planner, goals, world, clock, TimelineWriter(Path(out_dir)) if out_dir is not None else None)
     except LLMError as e:
         record.error = f"LLM error ({type(e).__name__}): {e}"
     except UserError as e:
@@ -139,8 +145,12 @@ def run_episode(
     return record
 
 
-def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:
-    """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D)."""
+def _run_steps(
+    record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock,
+    timeline: TimelineWriter | None = None,
+) -> None:
+    """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D);
+    each step's line goes to ``timeline`` when given."""
     goal_held = goals.check(world).all_met
     steps_since_goal = 0
     while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
@@ -159,6 +169,8 @@ def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, worl
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps
         _extend_path(record.trajectory, result.path)
+        if timeline is not None:
+            timeline.append(record, status, [world.get(a).label if a in world.objects else a for a in action.arguments])
         if action.is_done:
             record.done_called = True
             if not status.all_met and action.gave_up:

@@ -39,6 +39,8 @@ from more_agent.eval.store import (
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
+VIEWER_EPISODE_FN = "more_agent.viz.viewer:run_episode_with_viewer"
+"""The real episode function that also writes each episode's viewer (``more-agent eval --viewer``)."""
 
 DEFAULT_MAX_RETRIES = 2
 """Re-runs of an episode whose worker process died before it is recorded as an error."""

@@ -77,6 +77,8 @@ class EpisodeContext:
     """Whether to write the sensor frames of every step under ``out_dir``."""
     save_graph: bool = False
     """Whether to write the scene graph of every step under ``out_dir``."""
+    graph_pictures: bool = True
+    """With ``save_graph``: also draw each step's graph as a PNG (the episode viewer draws its own)."""
 
 
 class Planner(Protocol):

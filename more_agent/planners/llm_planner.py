@@ -56,6 +56,7 @@ from more_agent.llm import (
 from more_agent.llm.completion import Completion
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.exchanges import Exchange, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
@@ -67,7 +68,8 @@ from more_agent.viz.graph_plot import save_step_graph
 log = logging.getLogger(__name__)
 
 STEPS_FILE = "steps.jsonl"
-"""Per-step trace written in the episode folder: full and planning scene text, action, feedback."""
+"""Per-step trace written in the episode folder: full and planning scene text, action, feedback, and
+every LLM exchange of the step (``exchanges``: messages sent, answer, tokens, latency)."""
 
 INVALID = "invalid"
 """Name of the action recorded when the LLM gave no usable answer after the re-asks."""
@@ -150,9 +152,15 @@ class LLMPlanner:
         self.name = config.name
         self.llm: str | None = clients.spec
         self.config = config
-        self.clients = clients
+        self.exchanges: list[Exchange] = []
+        """Every LLM call of the current step (room labels, filter, plan, re-asks), for ``steps.jsonl``."""
+        self.clients = LLMClients(
+            plan=RecordingClient(clients.plan, self.exchanges), room=RecordingClient(clients.room, self.exchanges),
+            spec=clients.spec,
+        )
         self.out_dir: Path | None = None
         self.save_graph = False
+        self.graph_pictures = True
         self.usage = UsageMeter()
         self.llm_seconds = 0.0
         """Time spent waiting for LLM answers this episode (cache lookups included)."""
@@ -169,6 +177,7 @@ class LLMPlanner:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
         self.body = Embodiment.for_episode(context, config=self.config.policy, mapping=self.config.mapping)
         self.out_dir, self.save_graph = context.out_dir, context.save_graph
+        self.graph_pictures = context.graph_pictures
         if self.out_dir is not None:
             self.out_dir.mkdir(parents=True, exist_ok=True)
             (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
@@ -181,6 +190,7 @@ class LLMPlanner:
     def observe(self) -> None:
         """Build the scene graph, label new regions, put it into words."""
         body = self._body()
+        self.exchanges.clear()
         graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         labels = self._classify_rooms(graph)
         if labels:
@@ -238,11 +248,12 @@ class LLMPlanner:
             "step": action.step, "action": action.model_dump(),
             "scene": trace.scene_text if trace else None, "planning_scene": trace.planning_text if trace else None,
             "robot_room": self.view.robot_room if self.view else None,
+            "exchanges": [e.to_json() for e in self.exchanges],
         }
         with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
             f.write(json.dumps(line) + "\n")
         if self.save_graph and self.graph is not None:
-            save_step_graph(out, action.step, self.graph)
+            save_step_graph(out, action.step, self.graph, picture=self.graph_pictures)
 
     # -- steps ----------------------------------------------------------------------------------
     def _classify_rooms(self, graph: SceneGraph) -> dict[str, str]:

@@ -169,6 +169,7 @@ class OraclePlanner:
         self._observed: set[str] = set()
         self._body = Embodiment.for_episode(context)
         self._graph_dir = context.out_dir if context.save_graph else None
+        self._graph_pictures = context.graph_pictures
         self._steps = 0
         self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)
         self._turn_steps = self._body.low_level_steps
@@ -191,7 +192,7 @@ class OraclePlanner:
         ``--save-graph`` scene graph is built from."""
         self._body.sense()
         if self._graph_dir is not None:
-            save_step_graph(self._graph_dir, self._steps, self._body.build())
+            save_step_graph(self._graph_dir, self._steps, self._body.build(), picture=self._graph_pictures)
         self._steps += 1
 
     def observed_objects(self) -> set[str]:

@@ -68,3 +68,9 @@ class FrameWriter:
         save_frame(self.directory, f"frame_{self.count:04d}", rgb=frame.rgb, depth=frame.depth,
                    semantic=frame.semantic, class_names=self.class_names)
         self.count += 1
+
+
+def frames_written(directory: str | Path) -> int:
+    """How many frames a :class:`FrameWriter` has written into ``directory`` (0 when it does not exist)."""
+    directory = Path(directory)
+    return sum(1 for _ in directory.glob("frame_*_rgb.png")) if directory.is_dir() else 0

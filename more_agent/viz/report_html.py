@@ -1,22 +1,26 @@
-"""The self-contained HTML report of evaluation runs (``DIR/report.html``).
+"""The HTML report of evaluation runs (``DIR/report.html``).
 
-Table I and the per-task table, then one collapsible section per episode: a map thumbnail, goal
-conditions, the action trace with feedback, LLM usage and cost, and any error. Thumbnails are
-pluggable: ``DIR/episodes/<key>/map.png`` is embedded (base64) when the episode wrote one, else the
-trajectory alone is drawn as inline SVG. Every piece of record text is passed through ``html.escape``.
+Table I, the comparison plots (PNG files beside it, shown as linked thumbnails), the per-task table,
+then one collapsible section per episode: a map thumbnail, a link to the episode's viewer when it
+has one (``eval --viewer``), goal conditions, the action trace with feedback, LLM usage and cost,
+and any error. Pictures stay files the page links to (relative paths, loaded lazily), so the page
+stays small for large runs: ``DIR/episodes/<key>/map.png`` when the episode wrote one, else the
+trajectory alone as inline SVG. Every piece of record text is passed through ``html.escape``.
 """
 
 from __future__ import annotations
 
-import base64
+import os
 from collections.abc import Sequence
 from html import escape
 from pathlib import Path
+from urllib.parse import quote
 
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
 from more_agent.eval.record import EpisodeRecord
 from more_agent.eval.report import SourcedRecord, fmt
 from more_agent.eval.store import EPISODE_DIRS, episode_dirname
+from more_agent.viz.viewer import VIEWER_FILE
 
 THUMB_PX = 160
 """Width and height of episode thumbnails, in CSS pixels."""
@@ -26,17 +30,23 @@ body{font-family:system-ui,sans-serif;margin:1.5em;color:#222}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;font-size:13px}
 th{background:#f3f3f3}details{border:1px solid #ddd;margin:4px 0;padding:4px}
 summary{cursor:pointer}.ok{color:#176317}.fail{color:#a11}.err{color:#a11;font-weight:bold}
-.ep{display:flex;gap:1em;align-items:flex-start}pre{background:#f7f7f7;padding:6px;overflow-x:auto}
+.ep{display:flex;gap:1em;align-items:flex-start}.plots{display:flex;flex-wrap:wrap;gap:8px;align-items:flex-start}
+img.plot{max-width:560px;max-height:420px;border:1px solid #ddd}pre{background:#f7f7f7;padding:6px;overflow-x:auto}
 """
 
 
-def map_png_path(record: EpisodeRecord, run_dir: Path) -> Path | None:
-    """The episode's ``map.png`` under ``run_dir/episodes/``, looked up by resolved scene then 'auto'."""
+def episode_file(record: EpisodeRecord, run_dir: Path, name: str) -> Path | None:
+    """A file of the episode's folder under ``run_dir/episodes/``, looked up by resolved scene then 'auto'."""
     for scene in (record.scene or None, None):
-        p = Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner) / "map.png"
+        p = Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner) / name
         if p.is_file():
             return p
     return None
+
+
+def link(path: Path, base: Path) -> str:
+    """``path`` relative to the folder ``base`` as an escaped URL for an href / src attribute."""
+    return escape(quote(Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()))
 
 
 def trajectory_svg(trajectory: Sequence[tuple[float, float]], *, size_px: int = THUMB_PX) -> str:
@@ -61,12 +71,13 @@ def trajectory_svg(trajectory: Sequence[tuple[float, float]], *, size_px: int = 
     )
 
 
-def thumbnail_html(record: EpisodeRecord, run_dir: Path) -> str:
-    """The episode's map.png embedded, else its trajectory as SVG, else a placeholder."""
-    png = map_png_path(record, run_dir)
+def thumbnail_html(record: EpisodeRecord, run_dir: Path, base: Path) -> str:
+    """The episode's map.png linked (relative to the report folder ``base``), else its trajectory as SVG,
+    else a placeholder."""
+    png = episode_file(record, run_dir, "map.png")
     if png is not None:
-        data = base64.b64encode(png.read_bytes()).decode("ascii")
-        return f'<img alt="map" width="{THUMB_PX}" src="data:image/png;base64,{data}">'
+        src = link(png, base)
+        return f'<a href="{src}"><img alt="map" loading="lazy" width="{THUMB_PX}" src="{src}"></a>'
     return trajectory_svg(record.trajectory) or "<em>no trajectory</em>"
 
 
@@ -89,11 +100,13 @@ def _status(r: EpisodeRecord) -> str:
     return f'<span class="{cls}">{word}</span>'
 
 
-def episode_html(r: EpisodeRecord, run_dir: Path) -> str:
-    """One episode's collapsible section."""
+def episode_html(r: EpisodeRecord, run_dir: Path, base: Path) -> str:
+    """One episode's collapsible section; links are relative to the report folder ``base``."""
+    viewer = episode_file(r, run_dir, VIEWER_FILE)
+    viewer_link = f' | <a href="{link(viewer, base)}">viewer</a>' if viewer is not None else ""
     head = (
         f"{_status(r)} {escape(system_label(r))} | {escape(r.task)} | {escape(r.scene or '-')} | seed {r.seed} | "
-        f"TP {100 * r.task_progress:.0f}% rTP {100 * rtp(r):.0f}% | {r.high_level_steps} steps"
+        f"TP {100 * r.task_progress:.0f}% rTP {100 * rtp(r):.0f}% | {r.high_level_steps} steps{viewer_link}"
     )
     conds = "".join(
         f'<li class="{"ok" if c.satisfied else "fail"}">{"&#10003;" if c.satisfied else "&#10007;"} {escape(c.text)}</li>'
@@ -114,25 +127,37 @@ def episode_html(r: EpisodeRecord, run_dir: Path) -> str:
     if r.error is not None:
         err = f'<p class="err">{escape(r.error)}</p>' + (f"<pre>{escape(r.traceback)}</pre>" if r.traceback else "")
     return (
-        f"<details><summary>{head}</summary><div class=\"ep\"><div>{thumbnail_html(r, run_dir)}</div><div>"
+        f"<details><summary>{head}</summary><div class=\"ep\"><div>{thumbnail_html(r, run_dir, base)}</div><div>"
         f"<p>{escape(r.description)}</p>{err}<p>{usage}</p><ul>{conds}</ul>"
         f"<table><tr><th>step</th><th>action</th><th>arguments</th><th>result</th><th>feedback</th>"
         f"<th>low-level</th></tr>{acts}</table></div></div></details>"
     )
 
 
-def render_report(sourced: Sequence[SourcedRecord], *, title: str = "Evaluation report") -> str:
-    """The whole HTML document."""
+def plots_html(plots: Sequence[Path], base: Path) -> str:
+    """The plot files as linked thumbnails."""
+    return "".join(
+        f'<a href="{link(p, base)}"><img class="plot" alt="{escape(p.stem)}" src="{link(p, base)}"></a>' for p in plots
+    )
+
+
+def render_report(
+    sourced: Sequence[SourcedRecord], *, title: str = "Evaluation report", out_dir: Path | None = None,
+    plots: Sequence[Path] = (),
+) -> str:
+    """The whole HTML document, to be written into ``out_dir`` (links are relative to it; default the
+    current folder)."""
+    base = Path(out_dir) if out_dir is not None else Path.cwd()
     records = [s.record for s in sourced]
     cost = sum(r.llm_usage.cost_usd for r in records)
     calls = sum(r.llm_usage.calls for r in records)
     overall = _summary_table([([k], s) for k, s in by_system(records).items()], ["System"])
     tasks = _summary_table([([k, t], s) for (k, t), s in by_task(records).items()], ["System", "Task"])
-    episodes = "\n".join(episode_html(s.record, s.run_dir) for s in sourced)
+    episodes = "\n".join(episode_html(s.record, s.run_dir, base) for s in sourced)
     return (
         f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{escape(title)}</title>"
         f"<style>{_STYLE}</style></head><body><h1>{escape(title)}</h1>"
         f"<p>{len(records)} episodes, {calls} LLM calls, ${cost:.2f}. Means in percent with 95% intervals "
-        f"(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}"
+        f"(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}<div class=\"plots\">{plots_html(plots, base)}</div>"
         f"<details><summary>Per task</summary>{tasks}</details><h2>Episodes</h2>\n{episodes}\n</body></html>\n"
     )

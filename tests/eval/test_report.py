@@ -73,13 +73,17 @@ def test_html_escapes_all_record_text(tmp_path: Path) -> None:
     assert html.count("&lt;script&gt;alert(1)&lt;/script&gt;") >= 6
 
 
-def test_thumbnail_embeds_map_png_else_draws_trajectory(tmp_path: Path) -> None:
+def test_thumbnail_links_map_png_else_draws_trajectory_and_links_the_viewer(tmp_path: Path) -> None:
     with_map, without = rec("t1"), rec("t2")
-    ep_dir = tmp_path / "episodes" / episode_dirname("t1", None, 0, "more")
+    ep_dir = tmp_path / "run" / "episodes" / episode_dirname("t1", None, 0, "more")
     ep_dir.mkdir(parents=True)
     (ep_dir / "map.png").write_bytes(PNG)
-    html = render_report([SourcedRecord(with_map, tmp_path), SourcedRecord(without, tmp_path)])
-    assert html.count("data:image/png;base64," + base64.b64encode(PNG).decode()) == 1
+    (ep_dir / "viewer.html").write_text("<!DOCTYPE html>")
+    sourced = [SourcedRecord(with_map, tmp_path / "run"), SourcedRecord(without, tmp_path / "run")]
+    html = render_report(sourced, out_dir=tmp_path / "cmp")
+    assert "base64" not in html  # pictures are files the page links to, not inlined
+    assert html.count('src="../run/episodes/t1__auto__s0__more/map.png"') == 1
+    assert html.count('href="../run/episodes/t1__auto__s0__more/viewer.html"') == 1
     assert html.count("<polyline") == 1
 
 

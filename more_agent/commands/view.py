@@ -1,0 +1,22 @@
+"""``more-agent view EPISODE_DIR``: write the episode viewer, one self-contained HTML file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from more_agent.commands._common import err_console, user_errors_exit_2
+
+
+@user_errors_exit_2
+def view(
+    episode_dir: Annotated[Path, typer.Argument(help="Episode folder written by 'more-agent run' or 'eval' (holds episode.json).")],
+    out: Annotated[Path | None, typer.Option(help="HTML file to write (default: EPISODE_DIR/viewer.html).")] = None,
+) -> None:
+    """Write an HTML page that steps through the episode: frames, map, scene text, LLM requests and answers."""
+    from more_agent.viz.viewer import write_viewer
+
+    path = write_viewer(episode_dir, out)
+    err_console.print(f"wrote {path} (open it in a browser; left/right arrow keys move between steps)", highlight=False)

@@ -1,0 +1,39 @@
+"""Comparison plots: one PNG each, failure reasons read from the record."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PIL import Image
+
+from more_agent.eval.record import EpisodeRecord, Failure, LLMUsage
+from more_agent.viz.report_plots import PLOT_FILES, failure_reason, write_plots
+
+
+def rec(task: str, planner: str, **kw: object) -> EpisodeRecord:
+    return EpisodeRecord(task=task, scene="Rs_int", seed=0, planner=planner, llm=None if planner == "oracle" else "openai:m", **kw)
+
+
+def test_failure_reason_prefers_the_classified_cause_then_the_error() -> None:
+    assert failure_reason(rec("t", "more", success=True)) is None
+    assert failure_reason(rec("t", "more", failure=Failure(cause="never_observed"), error="x: y")) == "never_observed"
+    assert failure_reason(rec("t", "more", error="step limit of 50 high-level steps reached")) == (
+        "step limit of N high-level steps reached"
+    )
+    assert failure_reason(rec("t", "more", error="LLM error (LLMTimeout): read timed out")) == "LLM error"
+    assert failure_reason(rec("t", "more")) == "unclassified"
+
+
+def test_write_plots_draws_every_plot_even_with_missing_cells(tmp_path: Path) -> None:
+    records = [
+        rec("t1", "oracle", success=True, all_goals_met=True, task_progress=1.0, high_level_steps=7),
+        rec("t2", "oracle", error="oracle gave up: grasp failed 2 times", high_level_steps=3),
+        rec("t1", "more", failure=Failure(cause="step_limit"), high_level_steps=50,
+            llm_usage=LLMUsage(calls=3, prompt_tokens=900, completion_tokens=60)),
+    ]  # 'more' never ran t2: a blank cell in the heat map
+    paths = write_plots(records, tmp_path)
+    assert [p.name for p in paths] == list(PLOT_FILES.values())
+    for p in paths:
+        with Image.open(p) as im:
+            assert im.format == "PNG" and im.width > 300 and im.height > 150
+    assert write_plots([], tmp_path / "none") == []
