@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 from more_agent.llm import constants as C
 from more_agent.llm.client import ChatRequest, Generation
 from more_agent.llm.config import LLMConfig, StructuredOutput
+from more_agent.llm.limits import MAX_ERROR_CHARS, clip
 from more_agent.llm.errors import (
     LLMAuthError,
     LLMBadRequest,
@@ -173,7 +174,8 @@ class OpenAIBackend:
                 return Generation(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens, attempts)
             except openai.BadRequestError as e:
                 if with_schema and self.structured_output is StructuredOutput.AUTO:
-                    log.warning("%s rejected response_format (%s); parsing JSON from text now", self.base_url, e)
+                    log.warning("%s rejected response_format (%s); parsing JSON from text now",
+                                self.base_url, clip(str(e), MAX_ERROR_CHARS))
                     self.schema_supported = False
                     continue
                 raise LLMBadRequest(

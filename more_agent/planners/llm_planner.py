@@ -54,6 +54,7 @@ from more_agent.llm import (
     room_spec,
 )
 from more_agent.llm.completion import Completion
+from more_agent.llm.limits import MAX_FEEDBACK_CHARS, MAX_NAME_CHARS, clip
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
@@ -220,18 +221,19 @@ class LLMPlanner:
         """Run the subpolicy; the result counts the low-level steps and path since the last result
         (so the initial full turn is part of the first step's)."""
         result = self._run(action)
+        feedback = clip(result.feedback, MAX_FEEDBACK_CHARS)  # it reaches every later prompt through the history
         self.history.append(ActionRecord(
             step=len(self.history), name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback,
+            feedback=feedback,
         ))
         if self.out_dir is not None:
             self._write_step(self.out_dir, self.history[-1])
-        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
+        self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {feedback}"
         body = self._body()
         steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
         path = body.trajectory[self._reported_path - 1:] if len(body.trajectory) > self._reported_path else []
         self._reported_path = len(body.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
+        return ActionResult(ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=steps,
                             path=path, blocking=result.blocking)
 
     def observed_objects(self) -> set[str]:
@@ -297,7 +299,8 @@ class LLMPlanner:
         self._add(answer.completions)
         if answer.value.unknown_rooms or answer.value.unknown_objects:
             log.warning("filter answer named unknown rooms %s / objects %s: ignored",
-                        answer.value.unknown_rooms, answer.value.unknown_objects)
+                        clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
+                        clip(str(answer.value.unknown_objects), MAX_NAME_CHARS))
         return view.filtered(answer.value, always={view.robot_room})
 
     def _run(self, action: HighLevelAction) -> ActionResult:
