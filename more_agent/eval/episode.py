@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 from more_agent.errors import UserError
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
+from more_agent.redaction import redact
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
@@ -36,6 +37,9 @@ MAX_HIGH_LEVEL_STEPS = 50
 
 STEPS_AFTER_GOAL = 5
 """An episode ends when the planner acts more than this many steps after all goal conditions hold without done()."""
+
+LLM_ERROR_PREFIX = "LLM error"
+"""Start of ``record.error`` when the LLM failed (transport, server, replay miss): the episode ended abnormally."""
 
 EPISODE_FILE = "episode.json"
 MAP_FILE = "map.png"
@@ -91,7 +95,7 @@ def run_episode(
     CLI turns those into exit status 2. An LLM error (timeout after the retries, server gone, a
     replay miss) ends the episode with ``record.error`` naming it, everything so far kept.
     """
-    from more_agent.llm.errors import LLMError
+    from more_agent.llm.errors import LLMAuthError, LLMBadRequest, LLMError, LLMTransportError
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
@@ -117,14 +121,15 @@ def run_episode(
         clock.add("sense", t)
         _run_steps(record, planner, goals, world, clock)
     except LLMError as e:
-        record.error = f"LLM error ({type(e).__name__}): {e}"
+        record.error = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}"
+        record.retryable = isinstance(e, LLMTransportError) and not isinstance(e, (LLMAuthError, LLMBadRequest))
     except UserError as e:
         if strict:
             raise
-        record.error = str(e)
+        record.error = redact(str(e))
     except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
-        record.error = f"{type(e).__name__}: {e}"
-        record.traceback = traceback.format_exc()
+        record.error = redact(f"{type(e).__name__}: {e}")
+        record.traceback = redact(traceback.format_exc())
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
     if out_dir is not None:
@@ -137,6 +142,11 @@ def run_episode(
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return record
+
+
+def ended_abnormally(record: EpisodeRecord) -> bool:
+    """Whether the episode ended in an error of the system (code raised, the LLM failed), not of the agent."""
+    return record.traceback is not None or record.retryable or (record.error or "").startswith(LLM_ERROR_PREFIX)
 
 
 def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:

@@ -23,6 +23,7 @@ from more_agent.llm.errors import OversizeAnswer, ReplayMiss, Unparseable
 from more_agent.llm.jsontext import extract_json, json_schema_of
 from more_agent.llm.limits import MAX_ANSWER_CHARS, clip
 from more_agent.llm.usage import UsageMeter, cost_usd, price_of
+from more_agent.redaction import redact
 
 log = logging.getLogger(__name__)
 
@@ -156,7 +157,10 @@ class ChatClient:
         else:
             with llm_limiter():  # one cap on concurrent calls across evaluation workers
                 gen = self.backend.generate(request)
-            answer = CachedAnswer(clip(gen.text, MAX_ANSWER_CHARS), gen.model, gen.prompt_tokens, gen.completion_tokens)
+            # Clipped (an oversize answer is stored truncated) and redacted (a server echoing a key).
+            answer = CachedAnswer(
+                redact(clip(gen.text, MAX_ANSWER_CHARS)), redact(gen.model), gen.prompt_tokens, gen.completion_tokens
+            )
             attempts = gen.attempts
             if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REFRESH):
                 self.cache.put(key, request=key_fields, purpose=purpose, answer=answer)

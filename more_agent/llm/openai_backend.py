@@ -19,9 +19,11 @@ from more_agent.llm import constants as C
 from more_agent.llm.client import ChatRequest, Generation
 from more_agent.llm.config import LLMConfig, StructuredOutput
 from more_agent.llm.limits import MAX_ERROR_CHARS, clip
+from more_agent.redaction import has_credentials, redact, register_secret
 from more_agent.llm.errors import (
     LLMAuthError,
     LLMBadRequest,
+    LLMConfigError,
     LLMConnectionError,
     LLMRateLimited,
     LLMServerError,
@@ -93,7 +95,13 @@ class OpenAIBackend:
         ``require_key=False`` (replay runs never send a request).
         """
         base_url = (config.base_url or C.OPENAI_BASE_URL).rstrip("/")
+        if has_credentials(base_url):
+            raise LLMConfigError(
+                f"the base URL {redact(base_url)} must not contain credentials (they would be copied into "
+                f"errors and logs); put the key in {C.ENV_API_KEY}"
+            )
         key = config.api_key_value()
+        register_secret(key)
         if not key:
             if require_key and base_url == C.OPENAI_BASE_URL:
                 raise MissingAPIKey(
