@@ -8,6 +8,7 @@ at worst leaves one torn last line. ``read_records`` drops a torn last line (and
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -187,16 +188,29 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
 
 
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
-    """The specs with no record yet, in order."""
+    """The specs with no record yet, in order; a record of a scene file's scene counts for the file."""
     done: dict[tuple[str, int, str], set[str]] = {}
     for r in records:
         done.setdefault((r.task, r.seed, r.planner), set()).add(r.scene)
     out = []
     for s in specs:
         scenes = done.get((s.task, s.seed, s.planner))
-        if not scenes or (s.scene is not None and s.scene not in scenes):
+        if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
     return out
+
+
+@functools.cache
+def _scene_name(scene: str) -> str:
+    """The name a record gives the scene ``scene``: the ``name`` inside a scene file, else ``scene`` itself."""
+    if not scene.endswith(".json"):
+        return scene
+    from more_agent.sim.scene import load_scene
+
+    try:
+        return load_scene(scene).name
+    except UserError:
+        return scene
 
 
 def episode_dirname(task: str, scene: str | None, seed: int, planner: str) -> str:

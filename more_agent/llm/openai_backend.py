@@ -201,6 +201,10 @@ class OpenAIBackend:
                 error = LLMServerError(
                     f"{self.base_url} sent an invalid chat completion: {e}", status_code=e.status_code, attempts=attempts
                 )
+            except ValueError as e:  # the SDK's json.JSONDecodeError: a body that is not JSON at all
+                error = LLMServerError(
+                    f"{self.base_url} sent a body that is not JSON: {e}", status_code=200, attempts=attempts
+                )
             except openai.APITimeoutError:
                 error = LLMTimeout(
                     f"{self.model} at {self.base_url} did not answer within {self.timeout_s:g} s", attempts=attempts

@@ -137,3 +137,10 @@ def test_redact_and_dirname() -> None:
     assert redact("openai:gpt-4o?api_key=sk-123&base=x") == "openai:gpt-4o?api_key=***&base=x"
     assert redact(None) is None
     assert episode_dirname("a/b", None, 3, "more") == "a_b__auto__s3__more"
+
+
+def test_pending_knows_a_scene_file_by_the_name_inside() -> None:
+    tiny = str(Path(__file__).parents[1] / "fixtures" / "tiny_scene.json")
+    spec = EpisodeSpec(task="a", scene=tiny, seed=0)
+    assert pending([spec], [rec("a", 0, "tiny")]) == []
+    assert pending([spec], [rec("a", 0, "Rs_int")]) == [spec]
