@@ -149,6 +149,27 @@ def ended_abnormally(record: EpisodeRecord) -> bool:
     return record.traceback is not None or record.retryable or (record.error or "").startswith(LLM_ERROR_PREFIX)
 
 
+def map_is_complete(path: Path) -> bool:
+    """Whether ``path`` is a whole PNG (a crash on a full disk leaves none or a truncated one)."""
+    try:
+        with open(path, "rb") as f:
+            f.seek(-12, 2)
+            return f.read().endswith(_PNG_END)
+    except OSError:
+        return False
+
+
+_PNG_END = b"IEND\xaeB`\x82"
+
+
+def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
+    """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
+    rebuilt from (task, scene, seed) in its initial state (objects where they started)."""
+    from more_agent.sim.instantiate import instantiate
+
+    _write_map(record, instantiate(spec.task, spec.scene, spec.seed).world, out_dir)
+
+
 def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:
     """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D)."""
     goal_held = goals.check(world).all_met

@@ -306,8 +306,31 @@ def evaluate(
         records = prepare_run_dir(run_dir, config, resume=resume, allow_mixed=allow_mixed)
         if retry_errors:
             records = retire_retryable(run_dir, records)
+        if resume and config.episode_fn == DEFAULT_EPISODE_FN:
+            redraw_missing_maps(config, run_dir, records)
         return _run_pending(config, run_dir, records, max_concurrent_llm=max_concurrent_llm, max_retries=max_retries,
                             start_method=start_method, show_progress=show_progress, console=console)
+
+
+def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeRecord]) -> int:
+    """Redraw the ``map.png`` of recorded episodes whose picture is missing or torn; return how many."""
+    from more_agent.eval.episode import MAP_FILE, map_is_complete, redraw_map
+
+    by_key = {(r.task, r.seed, r.planner): r for r in records}
+    redrawn = 0
+    for spec in config_specs(config):
+        record = by_key.get((spec.task, spec.seed, spec.planner))
+        out_dir = run_dir / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+        if record is None or not record.trajectory or not out_dir.is_dir() or map_is_complete(out_dir / MAP_FILE):
+            continue
+        try:
+            redraw_map(spec, record, out_dir)
+        except Exception as e:  # noqa: BLE001 - a picture that cannot be redrawn must not stop the run
+            Console(stderr=True).print(f"cannot redraw {out_dir / MAP_FILE}: {type(e).__name__}: {e}",
+                                       markup=False, highlight=False)
+            continue
+        redrawn += 1
+    return redrawn
 
 
 def _run_pending(
