@@ -117,3 +117,12 @@ def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:
     maps[1].write_bytes(maps[1].read_bytes()[:500])
     evaluate(config, run, resume=True, show_progress=False)
     assert all(map_is_complete(m) and m.stat().st_size > 10_000 for m in maps)
+
+
+def test_a_success_on_floor_conditions_has_full_rtp() -> None:
+    # remove_sod's goal is (not (ontop turf_i floor_garden_0)): the floor is in every condition but is
+    # no object the robot observes; rTP read as the paper writes it still counts these conditions.
+    record = run_episode(EpisodeSpec(task="remove_sod", seed=0, planner="oracle"))
+    assert record.success and all("floor" in " ".join(c.objects) for c in record.goal_conditions)
+    assert "floor_garden_0" not in record.observed_objects
+    assert rtp(record) == 1.0
