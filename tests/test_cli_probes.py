@@ -140,3 +140,31 @@ def test_scene_render_says_which_file_it_wrote(tmp_path: Path) -> None:
     code, text = _invoke(["scene", "render", str(TINY), "--out", str(tmp_path / "plan")])
     assert code == 0 and f"wrote {tmp_path / 'plan.png'}" in text
     assert (tmp_path / "plan.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("episode_fn", ["slow_episode", "swallowing_episode"])
+def test_ctrl_c_always_exits_130_and_records_nothing_after_it(episode_fn: str, tmp_path: Path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from more_agent.eval.store import read_records
+
+    repo = Path(__file__).parents[1]
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-c", "from more_agent.cli import app; app(prog_name='more-agent')", "eval", "--tasks",
+           ",".join(f"t{i}" for i in range(40)), "--planner", "oracle", "--out", str(out), "--no-progress",
+           "--episode-fn", f"tests.eval.fake_episodes:{episode_fn}"]
+    env = {**os.environ, "PYTHONPATH": str(repo), "FAKE_EPISODE_SECONDS": "0.3"}
+    proc = subprocess.Popen(cmd, cwd=repo, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(read_records(out)) < 2:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err
+    records = read_records(out)
+    assert 2 <= len(records) < 40 and not any(r.error for r in records)
