@@ -80,6 +80,7 @@ def test_run_survives_every_fault_mode(kind: str, server: FakeOpenAIServer, tmp_
     assert result.exit_code == code, flat
     assert "Traceback" not in result.output and result.exception is None or isinstance(result.exception, SystemExit)
     assert text in flat or kind == "oversize"
+    assert len(result.output) < 20_000  # nothing a server sends is dumped whole to the terminal
     record = json.loads((tmp_path / "ep" / "episode.json").read_text())
     assert record["retryable"] is (code == 75)
     assert max(len(json.dumps(r.body)) for r in server.requests) < 60_000  # no answer echoed into a prompt

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
+from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.redaction import redact
 from more_agent.sim.navgrid import XY
@@ -185,7 +186,7 @@ def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, worl
         clock.add("act", t)
         record.actions.append(ActionRecord(
             step=record.high_level_steps, name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback, low_level_steps=result.low_level_steps,
+            feedback=clip(result.feedback, MAX_FEEDBACK_CHARS), low_level_steps=result.low_level_steps,
         ))
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps
