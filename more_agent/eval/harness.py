@@ -25,22 +25,22 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 from more_agent.errors import UserError, unknown_name_error
-from more_agent.interrupts import interrupted
-from more_agent.redaction import redact
 from more_agent.eval.limits import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.runlock import locked_run_dir
 from more_agent.eval.store import (
     EPISODE_DIRS,
     EPISODES_FILE,
     EpisodeWriter,
     RunConfig,
+    check_run_dir,
     episode_dirname,
     pending,
-    check_run_dir,
     prepare_run_dir,
     retire_retryable,
 )
-from more_agent.eval.runlock import locked_run_dir
+from more_agent.interrupts import interrupted
+from more_agent.redaction import redact
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
