@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Iterable
+from pathlib import Path
 
 
 class UserError(Exception):
@@ -20,3 +22,12 @@ def unknown_name_error(kind: str, name: str, candidates: Iterable[str]) -> UserE
     close = closest_names(name, candidates)
     hint = f"; closest: {', '.join(close)}" if close else ""
     return UserError(f"unknown {kind} {name!r}{hint}")
+
+
+def check_writable_dir(path: Path, what: str = "--out") -> None:
+    """Raise a UserError unless ``path`` is, or can be created as, a writable directory."""
+    if path.exists() and not path.is_dir():
+        raise UserError(f"{what} {path} exists and is not a directory")
+    existing = next((p for p in (path, *path.parents) if p.exists()), Path("."))
+    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+        raise UserError(f"cannot write to {path}: {existing} is not a writable directory")

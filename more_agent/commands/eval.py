@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from more_agent.commands._common import err_console, user_errors_exit_2
+from more_agent.commands._common import EXIT_RETRYABLE, err_console, user_errors_exit_2
 from more_agent.errors import UserError
 
 
@@ -24,6 +24,12 @@ def eval_(
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
     ] = None,
     resume: Annotated[bool, typer.Option(help="Continue the run in OUT: run only the missing episodes.")] = False,
+    retry_errors: Annotated[
+        bool, typer.Option(help="With --resume: also re-run the episodes that ended with a retryable error.")
+    ] = False,
+    allow_mixed: Annotated[
+        bool, typer.Option(help="With --resume: allow another planner, LLM, task list or seeds than the run in OUT.")
+    ] = False,
     max_llm_calls: Annotated[
         int | None, typer.Option(min=1, help="Limit on concurrent LLM calls across all workers.")
     ] = None,
@@ -34,21 +40,33 @@ def eval_(
         bool, typer.Option("--viewer", help="Save frames and maps and write each episode's viewer.html (linked from report.html).")
     ] = False,
 ) -> None:
-    """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl."""
+    """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl.
+
+    Exit status 75 when episodes ended with retryable errors (re-run them with --resume --retry-errors).
+    """
     from more_agent import __version__
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
     from more_agent.eval.report import load_runs, table_i_markdown, write_reports
-    from more_agent.eval.store import RunConfig, redact
+    from more_agent.eval.store import RunConfig, check_run_dir
+
+    from more_agent.llm import parse_llm_spec
 
     if viewer and episode_fn is not None:
         raise UserError("--viewer runs its own episode function: give either --viewer or --episode-fn")
     if viewer:
         episode_fn = VIEWER_EPISODE_FN
-    if llm is not None and llm != redact(llm):
-        raise UserError("--llm must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
+    check_run_dir(out)
+    if llm is not None:
+        parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
-    if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check the names now
+    if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
+        from more_agent.planners.base import make_planner
+        from more_agent.sim.scenes import get_scene
+
         check_task_names(names)
+        if scene is not None:
+            get_scene(scene)
+        make_planner(planner, llm)  # an unknown planner or a missing LLM fails here, before any episode
     config = RunConfig(
         planner=planner,
         llm=llm,
@@ -61,12 +79,22 @@ def eval_(
         more_agent_version=__version__,
     )
     records = evaluate(
-        config, out, resume=resume, max_concurrent_llm=max_llm_calls, max_retries=max_retries, show_progress=progress
+        config, out, resume=resume, retry_errors=retry_errors, allow_mixed=allow_mixed,
+        max_concurrent_llm=max_llm_calls, max_retries=max_retries, show_progress=progress,
     )
     sourced, _ = load_runs([out])
     paths = write_reports(sourced, out, title=f"{planner} on {tasks}")
     typer.echo(table_i_markdown([s.record for s in sourced]))
     errors = sum(r.error is not None for r in records)
+    retryable = sum(r.retryable for r in records)
     if errors:
-        err_console.print(f"[yellow]{errors} episode(s) ended with an error; see {out / 'report.html'}[/]")
-    err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False)
+        err_console.print(f"{errors} episode(s) ended with an error; see {out / 'report.html'}",
+                          style="yellow", highlight=False, markup=False)
+    err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False)
+    if retryable:
+        err_console.print(
+            f"{retryable} episode(s) hit a transient error (LLM transport, worker death) and are not results: "
+            f"re-run them with: more-agent eval ... --out {out} --resume --retry-errors (exit status {EXIT_RETRYABLE})",
+            style="yellow", highlight=False, markup=False,
+        )
+        raise typer.Exit(code=EXIT_RETRYABLE)

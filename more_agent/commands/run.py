@@ -12,8 +12,10 @@ from typing import Annotated
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
-from more_agent.commands._common import console, user_errors_exit_2
+from more_agent.commands._common import EXIT_FAILED, EXIT_RETRYABLE, console, user_errors_exit_2
+from more_agent.errors import check_writable_dir
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 
 NO_LLM_MESSAGE = (
@@ -39,21 +41,25 @@ def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Pa
 
 
 def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
-    """A short summary of an episode for the terminal."""
+    """A short summary of an episode for the terminal (record text shown as plain text, never markup)."""
+    from more_agent.eval.episode import EPISODE_FILE, MAP_FILE
+    from more_agent.viz.viewer import VIEWER_FILE
+
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_column(style="bold")
     table.add_column()
-    verdict = "[green]success[/]" if record.success else "[red]failure[/]"
-    table.add_row("episode", f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}")
-    table.add_row("result", f"{verdict}; goals met: {record.all_goals_met}; done called: {record.done_called}")
+    verdict = Text("success", style="green") if record.success else Text("failure", style="red")
+    table.add_row("episode", Text(f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}"))
+    table.add_row("result", Text.assemble(verdict, f"; goals met: {record.all_goals_met}; done called: {record.done_called}"))
     met = sum(c.satisfied for c in record.goal_conditions)
     table.add_row("progress", f"{record.task_progress:.2f} ({met}/{len(record.goal_conditions)} goal conditions)")
     table.add_row("steps", f"{record.high_level_steps} high-level, {record.low_level_steps} low-level")
     table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
     if record.error:
-        table.add_row("why", record.error)
-    files = [out_dir / "episode.json", out_dir / "map.png"] + [p for p in [out_dir / "viewer.html"] if p.is_file()]
-    table.add_row("files", ", ".join(map(str, files)))
+        table.add_row("why", Text(record.error))  # may quote a server: never markup
+    names = (EPISODE_FILE, MAP_FILE, VIEWER_FILE)
+    files = [out_dir / name for name in names if (out_dir / name).is_file()]
+    table.add_row("files", Text(", ".join(map(str, files)) or "none"))
     return table
 
 
@@ -62,15 +68,19 @@ def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
     planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
     scene: Annotated[str | None, typer.Option(help="Scene name or scene .json file (default: the task's first suitable scene).")] = None,
-    seed: Annotated[int, typer.Option(help="Seed of scene generation and task instantiation.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of scene generation and task instantiation.")] = 0,
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
     llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
     viewer: Annotated[bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")] = False,
 ) -> None:
-    """Run one episode of TASK and write its record and map."""
-    from more_agent.eval.episode import run_episode
+    """Run one episode of TASK and write its record and map.
+
+    Exit status 1 when the episode ended in an error of the system (code raised, the LLM refused),
+    75 when that error is transient (the LLM unreachable: run it again), 2 for bad input.
+    """
+    from more_agent.eval.episode import ended_abnormally, run_episode
     from more_agent.viz.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
 
@@ -80,14 +90,15 @@ def run(
     if planner is None:
         planner = default_planner(llm)
         if planner == DEFAULT_PLANNER:
-            console.print(NO_LLM_MESSAGE, highlight=False, soft_wrap=True)
+            console.print(NO_LLM_MESSAGE, highlight=False, soft_wrap=True, markup=False)
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
+    check_writable_dir(out_dir)
     spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm)
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
         )
     console.print(summary_table(record, out_dir))
-    if record.traceback:
-        raise typer.Exit(code=1)
+    if ended_abnormally(record):
+        raise typer.Exit(code=EXIT_RETRYABLE if record.retryable else EXIT_FAILED)

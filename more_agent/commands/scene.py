@@ -6,14 +6,15 @@ from collections import Counter
 from pathlib import Path
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
-from more_agent.commands._common import console, user_errors_exit_2
+from more_agent.commands._common import check_output_file, console, user_errors_exit_2
 
 app = typer.Typer(help="BEHAVIOR-1K scenes: list, show, generate, render.", no_args_is_help=True)
 
 SCENE_ARG = typer.Argument(..., help="Scene name (e.g. Rs_int) or a path to a scene .json file.")
-SEED_OPT = typer.Option(0, "--seed", help="Layout seed; same scene and seed give the same plan.")
+SEED_OPT = typer.Option(0, "--seed", min=0, help="Layout seed; same scene and seed give the same plan.")
 
 
 @app.command("list")
@@ -36,7 +37,7 @@ def show(scene: str = SCENE_ARG, seed: int = SEED_OPT) -> None:
     from more_agent.sim.scenes import get_scene
 
     s = get_scene(scene, seed)
-    console.print(f"[bold]{s.name}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
+    console.print(f"[bold]{escape(s.name)}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
                   f"{len(s.windows)} windows, {len(s.furniture)} furniture, {len(s.walls)} wall boxes")
     rooms = Table("room", "type", "area m²", "ground", "outdoor", "doors to", "furniture")
     for r in s.rooms:
@@ -44,8 +45,9 @@ def show(scene: str = SCENE_ARG, seed: int = SEED_OPT) -> None:
         links = [f"{d.id}:{next(x for x in d.rooms if x != r.id)}{'' if d.open else ' (closed)'}"
                  for d in s.doors if r.id in d.rooms]
         counts = Counter(f.category for f in s.furniture if f.room == r.id)
-        rooms.add_row(r.id, r.type, f"{area:.1f}", r.ground, "yes" if r.outdoor else "",
-                      ", ".join(links), ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())))
+        cells = (r.id, r.type, f"{area:.1f}", r.ground, "yes" if r.outdoor else "",
+                 ", ".join(links), ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())))
+        rooms.add_row(*map(escape, cells))  # a hand-written scene file may hold any text
     console.print(rooms)
 
 
@@ -60,8 +62,9 @@ def generate(
     from more_agent.sim.scene import save_scene
     from more_agent.sim.scenes import get_scene
 
+    check_output_file(out)
     save_scene(get_scene(scene, seed), out)
-    console.print(f"wrote {out}")
+    console.print(f"wrote {out}", highlight=False, markup=False)
 
 
 @app.command("render")
@@ -72,9 +75,14 @@ def render(
     out: Path = typer.Option(..., "--out", help="Where to write the PNG."),
     labels: bool = typer.Option(False, "--labels", help="Write furniture ids on the plan."),
 ) -> None:
-    """Draw the plan: rooms labelled, ground classes, walls, windows, open / closed doors, furniture."""
+    """Draw the plan: rooms labelled, ground classes, walls, windows, open / closed doors, furniture.
+
+    OUT without a suffix gets ``.png``; the line printed names the file written.
+    """
     from more_agent.sim.scenes import get_scene
     from more_agent.viz.plan import plot_plan
 
-    plot_plan(get_scene(scene, seed), out, label_furniture=labels)
-    console.print(f"wrote {out}")
+    path = out if out.suffix else out.with_suffix(".png")
+    check_output_file(path)
+    written = plot_plan(get_scene(scene, seed), path, label_furniture=labels)
+    console.print(f"wrote {written}", highlight=False, markup=False)

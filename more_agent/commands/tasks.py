@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from more_agent.commands._common import console, user_errors_exit_2
@@ -39,7 +40,7 @@ def list_(
 def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
     scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: the first suitable).")] = None,
-    seed: Annotated[int, typer.Option(help="Seed of scene generation and instantiation.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of scene generation and instantiation.")] = 0,
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
     from more_agent.sim.instantiate import instantiate, literal_text
@@ -47,15 +48,16 @@ def show(
 
     definition = load_task(task)
     scenes = suitable_scenes(task)
-    console.print(f"[bold]{task}[/]", highlight=False)
-    console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False)
+    console.print(task, style="bold", highlight=False, markup=False)
+    console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False, markup=False)
     console.print("goal:", highlight=False)
     for lit in definition.goal:
         console.print(f"  {literal_text(lit)}", highlight=False, markup=False)
     if not scenes and scene is None:
         return
     inst = instantiate(task, scene, seed)
-    console.print(f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False)
+    console.print(f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False,
+                  markup=False)
     console.print(f"description: {inst.description}", highlight=False, markup=False)
     table = Table(title="objects")
     for col in ("scope", "world object", "label", "category", "where"):
@@ -63,7 +65,7 @@ def show(
     for s, name in inst.scope.items():
         obj = inst.world.objects.get(name)
         where = f"{obj.relation} {obj.parent}" if obj is not None and obj.parent else (obj.room or "") if obj else ""
-        table.add_row(s, name, inst.label(s), obj.category if obj else "-", where)
+        table.add_row(*map(escape, (s, name, inst.label(s), obj.category if obj else "-", where)))
     console.print(table)
     if inst.unsupported_literals:
         console.print("init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False)

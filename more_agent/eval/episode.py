@@ -24,7 +24,9 @@ from typing import TYPE_CHECKING
 from more_agent.errors import UserError
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
 from more_agent.eval.timeline import TimelineWriter
+from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
+from more_agent.redaction import redact
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
@@ -38,6 +40,9 @@ MAX_HIGH_LEVEL_STEPS = 50
 
 STEPS_AFTER_GOAL = 5
 """An episode ends when the planner acts more than this many steps after all goal conditions hold without done()."""
+
+LLM_ERROR_PREFIX = "LLM error"
+"""Start of ``record.error`` when the LLM failed (transport, server, replay miss): the episode ended abnormally."""
 
 EPISODE_FILE = "episode.json"
 MAP_FILE = "map.png"
@@ -97,7 +102,7 @@ def run_episode(
     the slow per-step graph pictures unless ``save_graph`` asks for them
     (``more_agent.viz.viewer.run_episode_with_viewer`` then writes the page).
     """
-    from more_agent.llm.errors import LLMError
+    from more_agent.llm.errors import LLMAuthError, LLMBadRequest, LLMError, LLMTransportError
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
@@ -123,14 +128,15 @@ def run_episode(
         clock.add("sense", t)
         _run_steps(record, planner, goals, world, clock, TimelineWriter(Path(out_dir)) if out_dir is not None else None)
     except LLMError as e:
-        record.error = f"LLM error ({type(e).__name__}): {e}"
+        record.error = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}"
+        record.retryable = isinstance(e, LLMTransportError) and not isinstance(e, (LLMAuthError, LLMBadRequest))
     except UserError as e:
         if strict:
             raise
-        record.error = str(e)
+        record.error = redact(str(e))
     except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
-        record.error = f"{type(e).__name__}: {e}"
-        record.traceback = traceback.format_exc()
+        record.error = redact(f"{type(e).__name__}: {e}")
+        record.traceback = redact(traceback.format_exc())
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
     if out_dir is not None:
@@ -143,6 +149,32 @@ def run_episode(
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return record
+
+
+def ended_abnormally(record: EpisodeRecord) -> bool:
+    """Whether the episode ended in an error of the system (code raised, the LLM failed), not of the agent."""
+    return record.traceback is not None or record.retryable or (record.error or "").startswith(LLM_ERROR_PREFIX)
+
+
+def map_is_complete(path: Path) -> bool:
+    """Whether ``path`` is a whole PNG (a crash on a full disk leaves none or a truncated one)."""
+    try:
+        with open(path, "rb") as f:
+            f.seek(-12, 2)
+            return f.read().endswith(_PNG_END)
+    except OSError:
+        return False
+
+
+_PNG_END = b"IEND\xaeB`\x82"
+
+
+def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
+    """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
+    rebuilt from (task, scene, seed) in its initial state (objects where they started)."""
+    from more_agent.sim.instantiate import instantiate
+
+    _write_map(record, instantiate(spec.task, spec.scene, spec.seed).world, out_dir)
 
 
 def _run_steps(
@@ -164,7 +196,7 @@ def _run_steps(
         clock.add("act", t)
         record.actions.append(ActionRecord(
             step=record.high_level_steps, name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=result.feedback, low_level_steps=result.low_level_steps,
+            feedback=clip(result.feedback, MAX_FEEDBACK_CHARS), low_level_steps=result.low_level_steps,
         ))
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps

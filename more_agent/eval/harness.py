@@ -27,15 +27,20 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.eval.limits import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.runlock import locked_run_dir
 from more_agent.eval.store import (
     EPISODE_DIRS,
     EPISODES_FILE,
     EpisodeWriter,
     RunConfig,
+    check_run_dir,
     episode_dirname,
     pending,
     prepare_run_dir,
+    retire_retryable,
 )
+from more_agent.interrupts import interrupted
+from more_agent.redaction import redact
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
@@ -73,8 +78,11 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
     path = Path(arg)
     if arg in tasks.TASK_SETS:
         names = (task_set or tasks.task_set)(arg)
-    elif path.is_file():
-        text = path.read_text(encoding="utf-8")
+    elif _is_file(path):
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as e:
+            raise UserError(f"cannot read task file {path}: {getattr(e, 'strerror', None) or e}") from None
         if text.lstrip().startswith("["):
             try:
                 names = json.loads(text)
@@ -92,6 +100,14 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
     if not names:
         raise UserError(f"--tasks {arg!r} names no task; use a set ({', '.join(tasks.TASK_SETS)}), a file or 'a,b,c'")
     return names
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False for strings no file can be named (too long, NUL bytes)."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
 
 
 def config_specs(config: RunConfig) -> list[EpisodeSpec]:
@@ -131,9 +147,14 @@ def resolve_episode_fn(path: str) -> EpisodeFn:
 # Running one episode (in any process)
 
 
-def error_record(spec: EpisodeSpec, error: str, tb: str | None = None) -> EpisodeRecord:
-    """The record of an episode that raised or whose worker died: a failure with its error."""
-    return EpisodeRecord.for_spec(spec, error=error, traceback=tb)
+def error_record(spec: EpisodeSpec, error: str, tb: str | None = None, *, retryable: bool = False) -> EpisodeRecord:
+    """The record of an episode that raised or whose worker died: a failure with its (redacted) error.
+
+    ``retryable`` marks a transient cause (worker death, LLM transport) that ``--retry-errors`` re-runs.
+    """
+    return EpisodeRecord.for_spec(
+        spec, error=redact(error), traceback=redact(tb) if tb else None, retryable=retryable
+    )
 
 
 def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:
@@ -181,14 +202,17 @@ def iter_processes(
 ) -> Iterator[EpisodeRecord]:
     """Run episodes in a process pool, yielding records as they finish.
 
-    At most ``workers`` episodes are submitted at a time, so when a worker dies (the pool breaks)
-    only the episodes then in flight are charged: they are re-run in a fresh pool, each at most
-    ``max_retries`` times, then recorded as errors.
+    When a worker dies the pool breaks and every episode then in flight fails with it; only the
+    one that died is to blame, but the pool does not say which. So the episodes in flight become
+    *suspects* and are re-run one at a time in a fresh pool: a death is charged to an episode only
+    when it was the only one that failed with its pool. An episode charged more than
+    ``max_retries`` deaths is recorded as a retryable ``WorkerDied`` error.
     """
     ctx = multiprocessing.get_context(start_method)
     limiter = ProcessLimiter.create(ctx, max_concurrent_llm) if max_concurrent_llm else None
     queue = deque(range(len(specs)))
     deaths = [0] * len(specs)
+    suspects: set[int] = set()
     while queue:
         pool = ProcessPoolExecutor(
             max_workers=min(workers, len(queue)),
@@ -197,33 +221,43 @@ def iter_processes(
             initargs=(limiter, os.getpid()),
         )
         inflight: dict[Future[EpisodeRecord], int] = {}
-        retry: list[int] = []
-        broken = False
+        failed: list[int] = []
         try:
-            while inflight or (queue and not broken):
-                while queue and len(inflight) < workers and not broken:
+            while inflight or (queue and not failed):
+                while queue and not failed and len(inflight) < workers and _may_start(queue[0], inflight, suspects):
                     i = queue.popleft()
                     try:
                         inflight[pool.submit(execute_episode, fn_path, specs[i], str(run_dir))] = i
                     except BrokenProcessPool:
                         queue.appendleft(i)
-                        broken = True
+                        failed.append(-1)  # the pool broke between two submissions: no episode to blame
+                        break
                 done, _ = wait(inflight, return_when=FIRST_COMPLETED)
                 for fut in done:
                     i = inflight.pop(fut)
                     try:
                         record = fut.result()
                     except BrokenProcessPool:
-                        broken = True
-                        deaths[i] += 1
-                        if deaths[i] <= max_retries:
-                            retry.append(i)
-                            continue
-                        record = error_record(specs[i], f"WorkerDied: worker process died {deaths[i]} times")
+                        failed.append(i)
+                        continue
+                    suspects.discard(i)
                     yield record
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
-        queue.extendleft(reversed(retry))
+        victims = [i for i in failed if i >= 0]
+        if len(victims) == 1:
+            deaths[victims[0]] += 1
+        else:
+            suspects.update(victims)
+        for i in victims:
+            if deaths[i] > max_retries:
+                yield error_record(specs[i], f"WorkerDied: worker process died {deaths[i]} times", retryable=True)
+        queue.extendleft(reversed([i for i in victims if deaths[i] <= max_retries]))
+
+
+def _may_start(i: int, inflight: dict[Future[EpisodeRecord], int], suspects: set[int]) -> bool:
+    """Whether episode ``i`` may join the episodes in flight: a suspect runs alone."""
+    return not inflight or (i not in suspects and not suspects.intersection(inflight.values()))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -250,6 +284,8 @@ def evaluate(
     run_dir: Path,
     *,
     resume: bool = False,
+    retry_errors: bool = False,
+    allow_mixed: bool = False,
     max_concurrent_llm: int | None = None,
     max_retries: int = DEFAULT_MAX_RETRIES,
     start_method: str = "spawn",
@@ -259,13 +295,59 @@ def evaluate(
     """Run every missing episode of ``config`` into ``run_dir`` and return all of the run's records.
 
     Workers: ``config.ray_address`` set -> Ray (``'local'`` starts a local Ray); else
-    ``config.workers`` > 1 -> a process pool; else this process.
+    ``config.workers`` > 1 -> a process pool; else this process. The run folder is locked for the
+    whole run (a second writer gets a UserError naming the holder). With ``retry_errors`` (and
+    ``resume``) the episodes recorded with a retryable error are run again.
     """
     run_dir = Path(run_dir)
     resolve_episode_fn(config.episode_fn)  # fail early, in the parent, on a bad path
-    specs = config_specs(config)
-    records = prepare_run_dir(run_dir, config, resume=resume)
-    todo = pending(specs, records)
+    if retry_errors and not resume:
+        raise UserError("--retry-errors re-runs the retryable errors of an existing run: pass --resume too")
+    check_run_dir(run_dir)
+    with locked_run_dir(run_dir):
+        records = prepare_run_dir(run_dir, config, resume=resume, allow_mixed=allow_mixed)
+        if retry_errors:
+            records = retire_retryable(run_dir, records)
+        if resume and config.episode_fn == DEFAULT_EPISODE_FN:
+            redraw_missing_maps(config, run_dir, records)
+        return _run_pending(config, run_dir, records, max_concurrent_llm=max_concurrent_llm, max_retries=max_retries,
+                            start_method=start_method, show_progress=show_progress, console=console)
+
+
+def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeRecord]) -> int:
+    """Redraw the ``map.png`` of recorded episodes whose picture is missing or torn; return how many."""
+    from more_agent.eval.episode import MAP_FILE, map_is_complete, redraw_map
+
+    by_key = {(r.task, r.seed, r.planner): r for r in records}
+    redrawn = 0
+    for spec in config_specs(config):
+        record = by_key.get((spec.task, spec.seed, spec.planner))
+        out_dir = run_dir / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+        if record is None or not record.trajectory or not out_dir.is_dir() or map_is_complete(out_dir / MAP_FILE):
+            continue
+        try:
+            redraw_map(spec, record, out_dir)
+        except Exception as e:  # noqa: BLE001 - a picture that cannot be redrawn must not stop the run
+            Console(stderr=True).print(f"cannot redraw {out_dir / MAP_FILE}: {type(e).__name__}: {e}",
+                                       markup=False, highlight=False)
+            continue
+        redrawn += 1
+    return redrawn
+
+
+def _run_pending(
+    config: RunConfig,
+    run_dir: Path,
+    records: list[EpisodeRecord],
+    *,
+    max_concurrent_llm: int | None,
+    max_retries: int,
+    start_method: str,
+    show_progress: bool,
+    console: Console | None,
+) -> list[EpisodeRecord]:
+    """Run the episodes of ``config`` that have no record in ``records``, appending to the locked run folder."""
+    todo = pending(config_specs(config), records)
     if config.ray_address:
         from more_agent.eval.ray_backend import iter_ray
 
@@ -299,6 +381,8 @@ def evaluate(
 
         bar_id = bar.add_task(config.planner, total=len(todo), **fields())
         for record in stream:
+            if interrupted():  # Ctrl-C that native code turned into an ordinary error: not a result
+                raise KeyboardInterrupt
             writer.append(record)
             records.append(record)
             done, successes, errors = done + 1, successes + record.success, errors + (record.error is not None)

@@ -5,9 +5,12 @@ Per-episode values:
 - SR: ``record.success`` (all goal conditions met and ``done()`` called).
 - TTC: ``record.all_goals_met`` (all met, whether or not ``done()`` was called).
 - TP: ``record.task_progress`` (share of goal conditions met).
-- rTP: share of met conditions among the *observed* ones; a condition is observed when every
-  instance in its ``objects`` is in ``record.observed_objects`` (a condition that names no object
-  counts as observed). When an episode observed none of its conditions (or has none), its rTP is
+- rTP: share of met conditions among the *observed* ones. The paper (Sec. IV-A): "share of
+  completed goal conditions that include observed task objects", read literally: a condition is
+  observed when at least one instance in its ``objects`` is in ``record.observed_objects`` (a
+  condition that names no object counts as observed). Requiring *every* instance would never count
+  a condition on a floor or room fixture, which the robot does not observe as an object (see
+  docs/evaluation.md, "rTP"). When an episode observed none of its conditions (or has none), its rTP is
   **0.0**: the robot never saw what the task is about, so it made no relative progress. This keeps
   the same n for all four metrics and never rewards a planner for not exploring.
 
@@ -54,12 +57,12 @@ def tp(record: EpisodeRecord) -> float:
 
 
 def rtp(record: EpisodeRecord) -> float:
-    """Relative task progression: share of met conditions among those whose objects were all observed.
+    """Relative task progression: share of met conditions among those that include an observed task object.
 
     0.0 when no condition was observed (see the module docstring).
     """
     seen = set(record.observed_objects)
-    observed = [c for c in record.goal_conditions if all(o in seen for o in c.objects)]
+    observed = [c for c in record.goal_conditions if not c.objects or any(o in seen for o in c.objects)]
     if not observed:
         return 0.0
     return sum(c.satisfied for c in observed) / len(observed)

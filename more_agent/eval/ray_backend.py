@@ -110,7 +110,9 @@ def iter_ray(
                 try:
                     record = ray.get(ref)
                 except ray.exceptions.RayError as e:
-                    record = error_record(spec, f"WorkerDied: {type(e).__name__} after {max_retries} retries: {e}")
+                    record = error_record(
+                        spec, f"WorkerDied: {type(e).__name__} after {max_retries} retries: {e}", retryable=True
+                    )
                 yield record
     finally:
         if started:

@@ -8,6 +8,7 @@ at worst leaves one torn last line. ``read_records`` drops a torn last line (and
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -16,10 +17,14 @@ from types import TracebackType
 
 from pydantic import BaseModel, Field, ValidationError
 
-from more_agent.errors import UserError
+from more_agent.errors import UserError, check_writable_dir
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.runlock import LOCK_FILE
+from more_agent.redaction import redact as redact_text
 
 EPISODES_FILE = "episodes.jsonl"
+RETRIED_FILE = "retried.jsonl"
+"""Error records that ``--retry-errors`` replaced, kept for the record (not part of the results)."""
 RUN_FILE = "run.json"
 EPISODE_DIRS = "episodes"
 
@@ -38,12 +43,48 @@ class RunConfig(BaseModel):
     more_agent_version: str = Field(default="", description="Package version that wrote the run.")
 
 
-_SECRET = re.compile(r"(?i)(api[_-]?key|token|secret|password)=[^&;\s]*")
-
-
 def redact(spec: str | None) -> str | None:
-    """An LLM spec with any ``key=value`` credential replaced by ``key=***``."""
-    return None if spec is None else _SECRET.sub(lambda m: f"{m.group(1)}=***", spec)
+    """An LLM spec with any credential replaced by ``***`` (:func:`more_agent.redaction.redact`)."""
+    return None if spec is None else redact_text(spec)
+
+
+MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "episode_fn")
+"""What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
+
+
+def _comparable(config: RunConfig) -> dict[str, object]:
+    """The mixing fields of ``config``, task and seed lists as sets."""
+    values = config.model_dump(include=set(MIXING_FIELDS))
+    return {**values, "tasks": set(config.tasks), "seeds": set(config.seeds)}
+
+
+def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunConfig:
+    """The run configuration ``records`` imply, for a folder whose ``run.json`` is missing."""
+    planners = sorted({r.planner for r in records})
+    llms = sorted({str(r.llm) for r in records})
+    return config.model_copy(update={
+        "planner": planners[0] if len(planners) == 1 else ",".join(planners),
+        "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
+        "tasks": sorted({r.task for r in records} | set(config.tasks)),
+        "seeds": sorted({r.seed for r in records} | set(config.seeds)),
+    })
+
+
+def check_same_run(run_dir: Path, old: RunConfig, new: RunConfig) -> None:
+    """Raise a UserError naming every field in which ``new`` differs from the run already in ``run_dir``."""
+    a, b = _comparable(old), _comparable(new)
+    diffs = [f"{f}: {_show(a[f])} -> {_show(b[f])}" for f in MIXING_FIELDS if a[f] != b[f]]
+    if diffs:
+        raise UserError(
+            f"{run_dir} holds another run ({'; '.join(diffs)}); cannot resume it with these settings "
+            "(pass --allow-mixed to mix them in one folder, or choose another --out)"
+        )
+
+
+def _show(value: object) -> str:
+    """A short form of a config value for messages."""
+    text = ",".join(map(str, sorted(value))) if isinstance(value, set) else repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 class TornStoreError(UserError):
@@ -106,6 +147,10 @@ class EpisodeWriter:
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
+    def truncate(self) -> None:
+        """Empty the file."""
+        self._fh.truncate(0)
+
     def close(self) -> None:
         """Close the file."""
         self._fh.close()
@@ -119,17 +164,53 @@ class EpisodeWriter:
         self.close()
 
 
+def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[EpisodeRecord]:
+    """Move the retryable error records of ``run_dir`` to ``retried.jsonl``; return the records kept.
+
+    The retired records are appended (durably) to ``retried.jsonl`` before ``episodes.jsonl`` is
+    atomically replaced by the kept ones, so a crash at any point loses no record: at worst a
+    retired record is in both files, and the episode is simply re-run.
+    """
+    retired = [r for r in records if r.retryable]
+    if not retired:
+        return records
+    kept = [r for r in records if not r.retryable]
+    with EpisodeWriter(run_dir / RETRIED_FILE) as log:
+        for r in retired:
+            log.append(r)
+    tmp = run_dir / (EPISODES_FILE + ".tmp")
+    with EpisodeWriter(tmp) as writer:
+        writer.truncate()
+        for r in kept:
+            writer.append(r)
+    os.replace(tmp, run_dir / EPISODES_FILE)
+    return kept
+
+
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
-    """The specs with no record yet, in order."""
+    """The specs with no record yet, in order; a record of a scene file's scene counts for the file."""
     done: dict[tuple[str, int, str], set[str]] = {}
     for r in records:
         done.setdefault((r.task, r.seed, r.planner), set()).add(r.scene)
     out = []
     for s in specs:
         scenes = done.get((s.task, s.seed, s.planner))
-        if not scenes or (s.scene is not None and s.scene not in scenes):
+        if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
     return out
+
+
+@functools.cache
+def _scene_name(scene: str) -> str:
+    """The name a record gives the scene ``scene``: the ``name`` inside a scene file, else ``scene`` itself."""
+    if not scene.endswith(".json"):
+        return scene
+    from more_agent.sim.scene import load_scene
+
+    try:
+        return load_scene(scene).name
+    except UserError:
+        return scene
 
 
 def episode_dirname(task: str, scene: str | None, seed: int, planner: str) -> str:
@@ -156,24 +237,32 @@ def read_run_config(run_dir: Path) -> RunConfig | None:
         raise UserError(f"{path} is not a valid run configuration: {e}") from None
 
 
-def prepare_run_dir(run_dir: Path, config: RunConfig, *, resume: bool) -> list[EpisodeRecord]:
+def check_run_dir(run_dir: Path) -> None:
+    """Raise a UserError unless ``run_dir`` is (or can become) a writable run folder."""
+    check_writable_dir(run_dir)
+    for name in (EPISODES_FILE, RUN_FILE):
+        if (run_dir / name).exists() and not (run_dir / name).is_file():
+            raise UserError(f"{run_dir / name} exists and is not a file")
+
+
+def prepare_run_dir(
+    run_dir: Path, config: RunConfig, *, resume: bool, allow_mixed: bool = False
+) -> list[EpisodeRecord]:
     """Create or reopen a run directory and return the records already in it.
 
-    Without ``resume`` a non-empty directory is refused. With ``resume`` the planner and LLM must
-    match the stored ``run.json``; a torn last line is truncated.
+    Without ``resume`` a non-empty directory is refused. With ``resume`` the planner, LLM, tasks,
+    seeds, scene and episode function must match the stored ``run.json`` (or, when it is missing,
+    the records), unless ``allow_mixed``; a torn last line is truncated.
     """
     run_dir = Path(run_dir)
-    if run_dir.exists() and not run_dir.is_dir():
-        raise UserError(f"{run_dir} exists and is not a directory")
-    if run_dir.exists() and any(run_dir.iterdir()) and not resume:
+    check_run_dir(run_dir)
+    if run_dir.exists() and any(p.name != LOCK_FILE for p in run_dir.iterdir()) and not resume:
         raise UserError(f"{run_dir} is not empty; pass --resume to continue that run, or choose another --out")
     run_dir.mkdir(parents=True, exist_ok=True)
-    old = read_run_config(run_dir)
-    if old is not None and (old.planner, old.llm) != (config.planner, config.llm):
-        raise UserError(
-            f"{run_dir} holds a run of planner={old.planner!r} llm={old.llm!r}; "
-            f"cannot resume it with planner={config.planner!r} llm={config.llm!r}"
-        )
+    records = read_records(run_dir / EPISODES_FILE)
+    old = read_run_config(run_dir) or (_config_of_records(records, config) if records else None)
+    if old is not None and not allow_mixed:
+        check_same_run(run_dir, old, config)
     records = read_records(run_dir / EPISODES_FILE, repair=True)
     write_run_config(run_dir, config)
     return records

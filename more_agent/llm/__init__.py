@@ -41,6 +41,7 @@ from more_agent.llm.errors import (
     LLMTransportError,
     MissingAPIKey,
     MissingExtra,
+    OversizeAnswer,
     ReplayMiss,
     Unparseable,
 )
@@ -79,6 +80,7 @@ __all__ = [
     "LLMTransportError",
     "MissingAPIKey",
     "MissingExtra",
+    "OversizeAnswer",
     "ModelPrice",
     "PlanAnswer",
     "PlannedAction",

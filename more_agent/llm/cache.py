@@ -19,6 +19,21 @@ from pathlib import Path
 from typing import Any
 
 from more_agent.llm import constants as C
+from more_agent.llm.errors import LLMConfigError
+
+
+class CacheUnusable(LLMConfigError):
+    """The cache file cannot be opened, read or written (a folder, read-only, not a sqlite file)."""
+
+
+def check_cache_path(path: Path, *, write: bool = True) -> None:
+    """Raise CacheUnusable unless ``path`` can serve as the cache file (checked before any request)."""
+    hint = f"set {C.ENV_CACHE_PATH} to a writable file path or {C.ENV_CACHE_MODE}=off"
+    if path.exists() and not path.is_file():
+        raise CacheUnusable(f"LLM cache {path} is not a file; {hint}")
+    target = path if path.exists() else next((p for p in path.parents if p.exists()), Path("."))
+    if not os.access(target, (os.W_OK if write else os.R_OK)):
+        raise CacheUnusable(f"LLM cache {path} is not {'writable' if write else 'readable'}; {hint}")
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS responses (
@@ -61,6 +76,12 @@ class ResponseCache:
 
     def _connection(self) -> sqlite3.Connection:
         """This process's connection, created (with table and WAL mode) on first use."""
+        try:
+            return self._open()
+        except (sqlite3.Error, OSError) as e:
+            raise CacheUnusable(f"cannot open LLM cache {self.path}: {e}") from None
+
+    def _open(self) -> sqlite3.Connection:
         if self._conn is None or self._pid != os.getpid():
             self.path.parent.mkdir(parents=True, exist_ok=True)
             conn = sqlite3.connect(self.path, timeout=self._busy_timeout_s, isolation_level=None)
@@ -73,13 +94,22 @@ class ResponseCache:
 
     def get(self, key: str) -> CachedAnswer | None:
         """The stored answer for ``key``, or None."""
-        row = self._connection().execute(
-            "SELECT text, model, prompt_tokens, completion_tokens FROM responses WHERE key = ?", (key,)
-        ).fetchone()
+        try:
+            row = self._connection().execute(
+                "SELECT text, model, prompt_tokens, completion_tokens FROM responses WHERE key = ?", (key,)
+            ).fetchone()
+        except sqlite3.Error as e:
+            raise CacheUnusable(f"cannot read LLM cache {self.path}: {e}") from None
         return CachedAnswer(*row) if row else None
 
     def put(self, key: str, *, request: dict[str, Any], purpose: str, answer: CachedAnswer) -> None:
         """Store (or overwrite) the answer for ``key``."""
+        try:
+            self._insert(key, request=request, purpose=purpose, answer=answer)
+        except sqlite3.Error as e:
+            raise CacheUnusable(f"cannot write LLM cache {self.path}: {e}") from None
+
+    def _insert(self, key: str, *, request: dict[str, Any], purpose: str, answer: CachedAnswer) -> None:
         self._connection().execute(
             "INSERT OR REPLACE INTO responses VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
             (

@@ -20,10 +20,12 @@ from more_agent.eval.limits import llm_limiter
 from more_agent.llm.cache import CachedAnswer, ResponseCache, request_key
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.config import CacheMode, ModelPrice
-from more_agent.llm.errors import ReplayMiss, Unparseable
+from more_agent.llm.errors import OversizeAnswer, ReplayMiss, Unparseable
 from more_agent.llm.images import cache_view, image_stats
 from more_agent.llm.jsontext import extract_json, json_schema_of
+from more_agent.llm.limits import MAX_ANSWER_CHARS, clip
 from more_agent.llm.usage import UsageMeter, cost_usd, price_of
+from more_agent.redaction import redact
 
 log = logging.getLogger(__name__)
 
@@ -157,7 +159,10 @@ class ChatClient:
         else:
             with llm_limiter():  # one cap on concurrent calls across evaluation workers
                 gen = self.backend.generate(request)
-            answer = CachedAnswer(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens)
+            # Clipped (an oversize answer is stored truncated) and redacted (a server echoing a key).
+            answer = CachedAnswer(
+                redact(clip(gen.text, MAX_ANSWER_CHARS)), redact(gen.model), gen.prompt_tokens, gen.completion_tokens
+            )
             attempts = gen.attempts
             if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REFRESH):
                 self.cache.put(key, request=key_fields, purpose=purpose, answer=answer)
@@ -167,6 +172,8 @@ class ChatClient:
         )
         completion = dataclasses.replace(completion, **dataclasses.asdict(image_stats(request.messages)))
         self.usage.add(completion)
+        if len(completion.text) > MAX_ANSWER_CHARS:  # stored and returned clipped, and invalid whatever it holds
+            raise OversizeAnswer(completion=completion)
         log.debug(
             "llm %s model=%s tokens=%d+%d cost=%.5f cached=%s latency=%.2fs attempts=%d",
             purpose or "call", completion.model, completion.usage.prompt_tokens, completion.usage.completion_tokens,
@@ -188,16 +195,17 @@ class ChatClient:
         purpose: str,
         latency_s: float,
     ) -> Completion:
-        """The Completion for an answer: JSON extracted if asked for, cost from the price table."""
+        """The Completion for an answer (clipped): JSON extracted if asked for, cost from the price table."""
         if self.backend.free:
             cost, known = 0.0, True
         else:
             price = price_of(answer.model, self.prices) or price_of(self.backend.model, self.prices)
             known = price is not None
             cost = 0.0 if cached or price is None else cost_usd(price, answer.prompt_tokens, answer.completion_tokens)
+        text = clip(answer.text, MAX_ANSWER_CHARS)
         return Completion(
-            text=answer.text,
-            parsed=extract_json(answer.text) if request.schema is not None else None,
+            text=text,
+            parsed=extract_json(text) if request.schema is not None and len(text) <= MAX_ANSWER_CHARS else None,
             model=answer.model,
             usage=TokenUsage(answer.prompt_tokens, answer.completion_tokens),
             cost_usd=cost,

@@ -11,13 +11,22 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
+from more_agent.llm.limits import MAX_ANSWER_CHARS, MAX_ERROR_CHARS, clip
+from more_agent.redaction import redact
 
 if TYPE_CHECKING:
     from more_agent.llm.completion import Completion
 
 
 class LLMError(Exception):
-    """Base class of everything that goes wrong while asking a model."""
+    """Base class of everything that goes wrong while asking a model.
+
+    The message quotes server or model text: it is clipped and key-shaped strings are redacted, so
+    it can go into a record or onto the terminal as it is.
+    """
+
+    def __init__(self, message: str = "") -> None:
+        super().__init__(clip(redact(message), MAX_ERROR_CHARS))
 
 
 class LLMTransportError(LLMError):
@@ -61,11 +70,24 @@ class LLMAuthError(LLMStatusError):
 
 
 class Unparseable(LLMError):
-    """The answer holds no JSON object although one was asked for; ``completion`` is the answer."""
+    """The answer holds no JSON object although one was asked for; ``completion`` is the answer.
+
+    ``reason`` is what a re-ask tells the model.
+    """
+
+    reason = "no JSON object found in the answer"
 
     def __init__(self, message: str, *, completion: Completion) -> None:
         super().__init__(message)
         self.completion = completion
+
+
+class OversizeAnswer(Unparseable):
+    """The answer is longer than ``MAX_ANSWER_CHARS``: invalid, whatever it holds (recorded truncated)."""
+
+    def __init__(self, *, completion: Completion) -> None:
+        self.reason = f"the answer is over the limit of {MAX_ANSWER_CHARS} characters; answer with one short JSON object"
+        super().__init__(self.reason, completion=completion)
 
 
 class InvalidAnswer(LLMError):
@@ -76,7 +98,7 @@ class InvalidAnswer(LLMError):
 
     def __init__(self, reason: str, *, completions: tuple[Completion, ...] = ()) -> None:
         super().__init__(reason)
-        self.reason = reason
+        self.reason = str(self)
         self.completions = completions
 
 

@@ -18,9 +18,12 @@ from typing import TYPE_CHECKING, Any
 from more_agent.llm import constants as C
 from more_agent.llm.client import ChatRequest, Generation
 from more_agent.llm.config import LLMConfig, StructuredOutput
+from more_agent.llm.limits import MAX_ERROR_CHARS, clip
+from more_agent.redaction import has_credentials, redact, register_secret
 from more_agent.llm.errors import (
     LLMAuthError,
     LLMBadRequest,
+    LLMConfigError,
     LLMConnectionError,
     LLMRateLimited,
     LLMServerError,
@@ -92,7 +95,13 @@ class OpenAIBackend:
         ``require_key=False`` (replay runs never send a request).
         """
         base_url = (config.base_url or C.OPENAI_BASE_URL).rstrip("/")
+        if has_credentials(base_url):
+            raise LLMConfigError(
+                f"the base URL {redact(base_url)} must not contain credentials (they would be copied into "
+                f"errors and logs); put the key in {C.ENV_API_KEY}"
+            )
         key = config.api_key_value()
+        register_secret(key)
         if not key:
             if require_key and base_url == C.OPENAI_BASE_URL:
                 raise MissingAPIKey(
@@ -173,7 +182,8 @@ class OpenAIBackend:
                 return Generation(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens, attempts)
             except openai.BadRequestError as e:
                 if with_schema and self.structured_output is StructuredOutput.AUTO:
-                    log.warning("%s rejected response_format (%s); parsing JSON from text now", self.base_url, e)
+                    log.warning("%s rejected response_format (%s); parsing JSON from text now",
+                                self.base_url, clip(str(e), MAX_ERROR_CHARS))
                     self.schema_supported = False
                     continue
                 raise LLMBadRequest(
@@ -190,6 +200,10 @@ class OpenAIBackend:
             except openai.APIResponseValidationError as e:
                 error = LLMServerError(
                     f"{self.base_url} sent an invalid chat completion: {e}", status_code=e.status_code, attempts=attempts
+                )
+            except ValueError as e:  # the SDK's json.JSONDecodeError: a body that is not JSON at all
+                error = LLMServerError(
+                    f"{self.base_url} sent a body that is not JSON: {e}", status_code=200, attempts=attempts
                 )
             except openai.APITimeoutError:
                 error = LLMTimeout(

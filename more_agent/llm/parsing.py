@@ -17,6 +17,7 @@ from more_agent.errors import closest_names
 from more_agent.llm.answers import FilterResult, PlannedAction, Skill
 from more_agent.llm.errors import InvalidAnswer
 from more_agent.llm.jsontext import extract_json
+from more_agent.llm.limits import MAX_NAME_CHARS, MAX_REASONING_CHARS, clip
 
 Answer = str | Mapping[str, Any]
 """An answer as text or as its JSON object."""
@@ -36,6 +37,13 @@ def resolve_name(name: str, valid: Iterable[str]) -> str | None:
         return name
     matches = [v for v in valid if _norm(v) == _norm(name)]
     return matches[0] if len(matches) == 1 else None
+
+
+def _check_length(name: str) -> str:
+    """``name``, or InvalidAnswer when it is longer than any real name can be (``MAX_NAME_CHARS``)."""
+    if len(name) > MAX_NAME_CHARS:
+        raise InvalidAnswer(f"the name {clip(name, 40)!r} is over the limit of {MAX_NAME_CHARS} characters")
+    return name
 
 
 def _closest_hint(name: str, valid: Iterable[str]) -> str:
@@ -88,6 +96,14 @@ def _skill_and_args(answer: Answer, skill_names: Collection[str]) -> tuple[str, 
     return skill.strip().removesuffix("()"), [a.strip() for a in args], reasoning
 
 
+def _bounded_skill_and_args(answer: Answer, skill_names: Collection[str]) -> tuple[str, list[str], str]:
+    """:func:`_skill_and_args` with every name checked against ``MAX_NAME_CHARS`` and the reasoning clipped."""
+    name, args, reasoning = _skill_and_args(answer, skill_names)
+    for n in (name, *args):
+        _check_length(n)
+    return name, args, clip(reasoning, MAX_REASONING_CHARS)
+
+
 def parse_plan_answer(
     answer: Answer,
     skills: Sequence[Skill],
@@ -99,7 +115,7 @@ def parse_plan_answer(
     Raises InvalidAnswer naming the problem and the closest valid names.
     """
     by_name = {s.name: s for s in skills}
-    name, args, reasoning = _skill_and_args(answer, by_name)
+    name, args, reasoning = _bounded_skill_and_args(answer, by_name)
     canonical = resolve_name(name, by_name)
     if canonical is None:
         raise InvalidAnswer(
@@ -161,12 +177,15 @@ def parse_filter_answer(answer: Answer, scene: Mapping[str, Collection[str]]) ->
     unknown_rooms: list[str] = []
     unknown_objects: list[str] = []
     for room_name, objects in _filter_pairs(obj):
-        room = resolve_name(room_name, scene)
+        room = resolve_name(room_name, scene) if len(room_name) <= MAX_NAME_CHARS else None
         if room is None:
-            unknown_rooms.append(room_name)
+            unknown_rooms.append(clip(room_name, MAX_NAME_CHARS))
         else:
             kept.setdefault(room, [])
         for o_name in objects:
+            if len(o_name) > MAX_NAME_CHARS:
+                unknown_objects.append(clip(o_name, MAX_NAME_CHARS))
+                continue
             in_room = resolve_name(o_name, scene[room]) if room is not None else None
             anywhere = in_room or resolve_name(o_name, home)
             target = room if in_room else (home[anywhere][0] if anywhere and len(home[anywhere]) == 1 else None)
@@ -190,6 +209,7 @@ def parse_room_label(answer: Answer, labels: Collection[str] | None = None) -> s
     raw = obj.get("room") if obj is not None else (answer.strip().rstrip(".!") if isinstance(answer, str) else None)
     if not isinstance(raw, str) or not raw.strip() or len(raw.split()) > 4:
         raise InvalidAnswer('expected {"room": <room type>}')
+    _check_length(raw)
     if labels is None:
         return _norm(raw).replace(" ", "_")
     label = resolve_name(raw, labels)

@@ -16,6 +16,7 @@ from pydantic import BaseModel
 from more_agent.llm.client import LLMClient
 from more_agent.llm.completion import ChatMessage, Completion
 from more_agent.llm.errors import InvalidAnswer, Unparseable
+from more_agent.llm.limits import MAX_ECHO_CHARS, clip
 
 T = TypeVar("T")
 
@@ -55,12 +56,12 @@ def ask_validated(
             completions.append(completion)
             return Validated(validate(answer), tuple(completions))
         except Unparseable as e:
-            completion, reason = e.completion, "no JSON object found in the answer"
+            completion, reason = e.completion, e.reason
             completions.append(completion)
         except InvalidAnswer as e:
             reason = e.reason
         conversation += [
-            ChatMessage(role="assistant", content=completion.text),
+            ChatMessage(role="assistant", content=clip(completion.text, MAX_ECHO_CHARS)),
             ChatMessage(role="user", content=REASK_TEMPLATE.format(reason=reason)),
         ]
     raise InvalidAnswer(reason, completions=tuple(completions))

@@ -8,10 +8,11 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.errors import closest_names
-from more_agent.llm.cache import ResponseCache
+from more_agent.llm.cache import ResponseCache, check_cache_path
 from more_agent.llm.client import Backend, ChatClient
 from more_agent.llm.config import CacheMode, LLMConfig
 from more_agent.llm.errors import BadLLMSpec
+from more_agent.redaction import has_credentials
 
 BACKEND_KINDS = ("openai", "llamacpp")
 SPEC_HELP = "use openai:MODEL (e.g. openai:gpt-4o) or llamacpp:PATH.gguf"
@@ -30,7 +31,15 @@ class LLMSpec(BaseModel):
 
 
 def parse_llm_spec(spec: str) -> LLMSpec:
-    """Parse ``KIND:MODEL``; raises BadLLMSpec saying what is wrong and what to write instead."""
+    """Parse ``KIND:MODEL``; raises BadLLMSpec saying what is wrong and what to write instead.
+
+    A spec holding credentials (``?api_key=...``, an ``sk-...`` key) is refused: specs are written
+    into records, caches and run.json; keys belong in the environment.
+    """
+    if has_credentials(spec):
+        raise BadLLMSpec(
+            "the LLM spec must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)"
+        )
     kind, sep, model = spec.strip().partition(":")
     kind, model = kind.strip().lower(), model.strip()
     if not sep:
@@ -78,7 +87,10 @@ def make_backend(spec: LLMSpec, config: LLMConfig) -> Backend:
 def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:
     """A ready client for ``spec`` with the configured cache mode; raises LLMConfigError subclasses."""
     spec = parse_llm_spec(spec) if isinstance(spec, str) else spec
-    cache = ResponseCache(config.cache_path) if config.cache_mode is not CacheMode.OFF else None
+    cache = None
+    if config.cache_mode is not CacheMode.OFF:
+        check_cache_path(config.cache_path, write=config.cache_mode is not CacheMode.REPLAY)
+        cache = ResponseCache(config.cache_path)
     return ChatClient(
         make_backend(spec, config),
         cache=cache,

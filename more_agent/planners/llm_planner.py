@@ -54,6 +54,7 @@ from more_agent.llm import (
     room_spec,
 )
 from more_agent.llm.completion import Completion
+from more_agent.llm.limits import MAX_NAME_CHARS, clip
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.exchanges import Exchange, RecordingClient
@@ -297,7 +298,8 @@ class LLMPlanner:
         self._add(answer.completions)
         if answer.value.unknown_rooms or answer.value.unknown_objects:
             log.warning("filter answer named unknown rooms %s / objects %s: ignored",
-                        answer.value.unknown_rooms, answer.value.unknown_objects)
+                        clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
+                        clip(str(answer.value.unknown_objects), MAX_NAME_CHARS))
         return view.filtered(answer.value, always={view.robot_room})
 
     def _run(self, action: HighLevelAction) -> ActionResult:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -26,10 +26,19 @@ FREE_SPACE_CLASSES: tuple[str, ...] = ("floor", "carpet", "lawn", "driveway")
 STRUCTURAL_CLASSES: tuple[str, ...] = ("unlabeled", "floor", "carpet", "lawn", "driveway", "wall", "door", "window")
 """Semantic classes with fixed ids (their index); object categories follow, per world."""
 
-Bounds2D = tuple[float, float, float, float]
+MAX_COORD_M = 1_000.0
+"""Largest coordinate or size of a scene file in metres (a typo like 1e9 is rejected, not allocated)."""
+
+MAX_SCENE_EXTENT_M = 200.0
+"""Largest width or depth of a scene (generated BEHAVIOR-1K plans span up to about 95 m); bounds the map grids."""
+
+Metres = Annotated[float, Field(ge=-MAX_COORD_M, le=MAX_COORD_M)]
+"""A finite coordinate or length in metres within +-MAX_COORD_M."""
+
+Bounds2D = tuple[Metres, Metres, Metres, Metres]
 """(xmin, ymin, xmax, ymax) in metres."""
 
-Vec3 = tuple[float, float, float]
+Vec3 = tuple[Metres, Metres, Metres]
 
 
 class SceneError(UserError, ValueError):
@@ -37,7 +46,7 @@ class SceneError(UserError, ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _check_bounds(b: Bounds2D, what: str) -> None:
@@ -64,8 +73,8 @@ class Wall(_Strict):
     """A solid axis-aligned wall box from z_min to z_max (window openings split walls vertically)."""
 
     bounds: Bounds2D = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres.")
-    z_min: float = Field(default=0.0, description="Bottom of the box in metres.")
-    z_max: float = Field(default=2.6, description="Top of the box in metres.")
+    z_min: Metres = Field(default=0.0, description="Bottom of the box in metres.")
+    z_max: Metres = Field(default=2.6, description="Top of the box in metres.")
 
     @model_validator(mode="after")
     def _valid(self) -> Wall:
@@ -80,8 +89,8 @@ class Window(_Strict):
 
     id: str
     bounds: Bounds2D = Field(description="Footprint of the opening within its wall.")
-    sill: float = Field(default=0.9, description="Bottom of the glass in metres.")
-    top: float = Field(default=2.0, description="Top of the glass in metres.")
+    sill: Metres = Field(default=0.9, description="Bottom of the glass in metres.")
+    top: Metres = Field(default=2.0, description="Top of the glass in metres.")
     rooms: tuple[str, ...] = Field(default=(), description="Rooms on either side (one for an exterior window).")
 
 
@@ -94,12 +103,18 @@ class Door(_Strict):
 
     id: str = Field(description="Readable id, e.g. 'door_3'.")
     rooms: tuple[str, str] = Field(description="The two rooms it connects.")
-    center: tuple[float, float] = Field(description="Centre of the opening (x, y) in metres.")
-    width: float = Field(gt=0.3, description="Clear width of the opening in metres.")
+    center: tuple[Metres, Metres] = Field(description="Centre of the opening (x, y) in metres.")
+    width: float = Field(gt=0.3, le=MAX_COORD_M, description="Clear width of the opening in metres.")
     axis: Literal["x", "y"] = Field(description="World axis along which the opening extends (the wall's direction).")
-    thickness: float = Field(default=0.1, gt=0, description="Wall thickness at the door in metres.")
-    height: float = Field(default=2.1, gt=1.0, description="Height of the opening; a lintel sits above it.")
+    thickness: float = Field(default=0.1, gt=0, le=MAX_COORD_M, description="Wall thickness at the door in metres.")
+    height: float = Field(default=2.1, gt=1.0, le=MAX_COORD_M, description="Height of the opening; a lintel sits above it.")
     open: bool = Field(default=True, description="Initial state.")
+
+    @model_validator(mode="after")
+    def _two_rooms(self) -> Door:
+        if self.rooms[0] == self.rooms[1]:
+            raise ValueError(f"a door joins two different rooms, got {self.rooms[0]!r} twice")
+        return self
 
     def bounds(self) -> Bounds2D:
         """Footprint of the door leaf / opening."""
@@ -150,7 +165,7 @@ class Scene(_Strict):
     name: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(default=0, description="Seed the plan was generated with (0 for hand-written scenes).")
     bounds: Bounds2D = Field(description="Extent of the plan (xmin, ymin, xmax, ymax) in metres.")
-    wall_height: float = Field(default=2.6, gt=0)
+    wall_height: float = Field(default=2.6, gt=0, le=MAX_COORD_M)
     rooms: list[Room] = Field(min_length=1)
     walls: list[Wall] = Field(default_factory=list)
     doors: list[Door] = Field(default_factory=list)
@@ -161,6 +176,9 @@ class Scene(_Strict):
     @model_validator(mode="after")
     def _consistent(self) -> Scene:
         _check_bounds(self.bounds, "scene")
+        extent = max(self.bounds[2] - self.bounds[0], self.bounds[3] - self.bounds[1])
+        if extent > MAX_SCENE_EXTENT_M:
+            raise ValueError(f"scene bounds span {extent:g} m, over the limit of {MAX_SCENE_EXTENT_M:g} m")
         room_ids = [r.id for r in self.rooms]
         _unique(room_ids, "room")
         _unique([d.id for d in self.doors] + [f.id for f in self.furniture] + [w.id for w in self.windows], "object")
@@ -208,11 +226,15 @@ def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene JSON file; raise SceneError naming the bad field's path."""
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise SceneError(f"scene file not found: {path}") from None
     except json.JSONDecodeError as e:
         raise SceneError(f"scene file {path} is not valid JSON: line {e.lineno} column {e.colno}: {e.msg}") from None
+    except RecursionError:
+        raise SceneError(f"scene file {path} is nested too deeply to be a scene") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise SceneError(f"cannot read scene file {path}: {getattr(e, 'strerror', None) or e}") from None
     try:
         return Scene.model_validate(data)
     except ValidationError as e:

@@ -83,3 +83,19 @@ def limited_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> Episod
         mine.unlink()
     rec = deterministic_episode(spec, out_dir=out_dir)
     return rec.model_copy(update={"timings": {"holders": float(holders)}})
+
+
+def flaky_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """A retryable LLM error for tasks named 'flaky*' while ``FAKE_LLM_DOWN`` is set, else ``deterministic_episode``."""
+    if spec.task.startswith("flaky") and os.environ.get("FAKE_LLM_DOWN"):
+        return EpisodeRecord.for_spec(spec, error="LLM error (LLMServerError): 500 on every attempt", retryable=True)
+    return deterministic_episode(spec, out_dir=out_dir)
+
+
+def swallowing_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """Sleeps and turns a KeyboardInterrupt into another exception, as native callbacks (numba) can."""
+    try:
+        time.sleep(float(os.environ.get("FAKE_EPISODE_SECONDS", "0.15")))
+    except KeyboardInterrupt:
+        raise RuntimeError("error in a native callback") from None
+    return deterministic_episode(spec, out_dir=out_dir)

@@ -100,3 +100,29 @@ def test_a_raising_planner_is_recorded_with_its_traceback(tmp_path: Path) -> Non
 def test_unknown_task_is_recorded_not_raised() -> None:
     record = run_episode(SPEC.model_copy(update={"task": "no_such_task"}))
     assert record.error is not None and "unknown task" in record.error and record.traceback is None
+
+
+def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:
+    from more_agent.eval.episode import MAP_FILE, map_is_complete
+    from more_agent.eval.harness import evaluate
+    from more_agent.eval.store import RunConfig
+
+    config = RunConfig(planner="oracle", tasks=["putting_shopping_away"], seeds=[0, 1], scene="Rs_int",
+                       episode_fn="more_agent.eval.episode:run_episode")
+    run = tmp_path / "run"
+    evaluate(config, run, show_progress=False)
+    maps = sorted(run.glob(f"episodes/*/{MAP_FILE}"))
+    assert len(maps) == 2 and all(map_is_complete(m) for m in maps)
+    maps[0].unlink()  # as after a crash on a full disk
+    maps[1].write_bytes(maps[1].read_bytes()[:500])
+    evaluate(config, run, resume=True, show_progress=False)
+    assert all(map_is_complete(m) and m.stat().st_size > 10_000 for m in maps)
+
+
+def test_a_success_on_floor_conditions_has_full_rtp() -> None:
+    # remove_sod's goal is (not (ontop turf_i floor_garden_0)): the floor is in every condition but is
+    # no object the robot observes; rTP read as the paper writes it still counts these conditions.
+    record = run_episode(EpisodeSpec(task="remove_sod", seed=0, planner="oracle"))
+    assert record.success and all("floor" in " ".join(c.objects) for c in record.goal_conditions)
+    assert "floor_garden_0" not in record.observed_objects
+    assert rtp(record) == 1.0

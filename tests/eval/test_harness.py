@@ -80,6 +80,30 @@ def test_process_pool_matches_inline_and_survives_dying_workers(tmp_path: Path) 
     assert Counter(r.key() for r in read_records(tmp_path / "pool")).most_common(1)[0][1] == 1
 
 
+def test_a_death_is_charged_only_to_the_episode_that_died(tmp_path: Path) -> None:
+    tasks = ["a", "die", "b", "c", "d"]
+    pooled = evaluate(config("dying_episode", tasks, seeds=2, workers=2), tmp_path / "pool", max_retries=0,
+                      show_progress=False)
+    assert sorted(r.task for r in pooled if r.error) == ["die", "die"]
+    assert all(r.retryable and r.error.startswith("WorkerDied") for r in pooled if r.error)
+    assert len(pooled) == 10 == len({r.key() for r in pooled})
+
+
+def test_retry_errors_reruns_exactly_the_retryable_ones(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    cfg = config("flaky_episode", ["a", "flaky1", "bad", "flaky2"], seeds=2)
+    monkeypatch.setenv("FAKE_LLM_DOWN", "1")
+    first = evaluate(cfg, tmp_path / "run", show_progress=False)
+    assert sorted(r.task for r in first if r.retryable) == ["flaky1", "flaky1", "flaky2", "flaky2"]
+    assert evaluate(cfg, tmp_path / "run", resume=True, show_progress=False) == first  # plain resume: nothing to run
+    monkeypatch.delenv("FAKE_LLM_DOWN")
+    with pytest.raises(UserError, match="pass --resume"):
+        evaluate(cfg, tmp_path / "run", retry_errors=True, show_progress=False)
+    after = evaluate(cfg, tmp_path / "run", resume=True, retry_errors=True, show_progress=False)
+    assert not any(r.error for r in after) and len(after) == 8 == len(read_records(tmp_path / "run"))
+    assert Counter(r.key() for r in read_records(tmp_path / "run")).most_common(1)[0][1] == 1
+    assert len(read_records(tmp_path / "run" / "retried.jsonl")) == 4
+
+
 def test_process_limiter_bounds_concurrent_llm_calls(tmp_path: Path) -> None:
     cfg = config("limited_episode", ["a", "b", "c", "d"], workers=3)
     records = evaluate(cfg, tmp_path / "lim", max_concurrent_llm=1, show_progress=False)
@@ -134,3 +158,11 @@ def test_kill_9_then_resume_runs_every_episode_exactly_once(tmp_path: Path, monk
     assert len(keys) == 20 and set(keys.values()) == {1}
     assert outcome(after) == outcome([fake_episodes.deterministic_episode(s) for s in config_specs(cfg)])
     assert evaluate(cfg, run, resume=True, show_progress=False) == after  # nothing left to run
+
+
+def test_missing_ray_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
+    from more_agent.eval.ray_backend import import_ray
+
+    monkeypatch.setitem(sys.modules, "ray", None)
+    with pytest.raises(UserError, match=r"more-agent\[ray\]"):
+        import_ray()

@@ -48,12 +48,12 @@ def test_tp_is_share_of_conditions_met() -> None:
     assert tp(r) == pytest.approx(0.5)
 
 
-def test_rtp_counts_only_conditions_whose_objects_were_all_observed() -> None:
+def test_rtp_counts_the_conditions_that_include_an_observed_task_object() -> None:
     r = rec(
-        conds=[(True, ["a", "table"]), (False, ["b", "table"]), (False, ["c", "table"]), (True, ["d", "shelf"])],
-        observed=["a", "b", "table", "d"],  # 'shelf' unseen -> condition 3 excluded; 'c' unseen -> 2 excluded
+        conds=[(True, ["a", "floor"]), (False, ["b", "table"]), (False, ["c", "shelf"]), (True, ["d", "shelf"])],
+        observed=["a", "b", "d"],  # 'c' and 'shelf' unseen -> condition 2 excluded; a floor is never "seen"
     )
-    assert rtp(r) == pytest.approx(1 / 2)
+    assert rtp(r) == pytest.approx(2 / 3)
     assert tp(r) == pytest.approx(2 / 4)
 
 

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 from more_agent.errors import UserError
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.runlock import RunFolderBusy, locked_run_dir
 from more_agent.eval.store import (
     EpisodeWriter,
     RunConfig,
@@ -18,6 +22,7 @@ from more_agent.eval.store import (
     read_records,
     read_run_config,
     redact,
+    retire_retryable,
 )
 
 
@@ -75,10 +80,49 @@ def test_prepare_resume_checks_planner_and_returns_records(tmp_path: Path) -> No
     assert prepare_run_dir(tmp_path / "run", config(), resume=False) == []
     write(tmp_path / "run" / "episodes.jsonl", [rec("a")])
     assert read_run_config(tmp_path / "run") == config()
-    with pytest.raises(UserError, match="cannot resume"):
+    with pytest.raises(UserError, match="planner: 'oracle' -> 'more'; llm: None -> 'openai:gpt-4o'.*--allow-mixed"):
         prepare_run_dir(tmp_path / "run", config(planner="more", llm="openai:gpt-4o"), resume=True)
-    assert [r.task for r in prepare_run_dir(tmp_path / "run", config(tasks=["a", "b"]), resume=True)] == ["a"]
+    with pytest.raises(UserError, match="tasks: a -> a,b"):
+        prepare_run_dir(tmp_path / "run", config(tasks=["a", "b"]), resume=True)
+    mixed = prepare_run_dir(tmp_path / "run", config(tasks=["a", "b"]), resume=True, allow_mixed=True)
+    assert [r.task for r in mixed] == ["a"]
     assert read_run_config(tmp_path / "run").tasks == ["a", "b"]
+
+
+def test_resume_without_run_json_checks_the_records(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    run.mkdir()
+    write(run / "episodes.jsonl", [rec("a")])  # run.json lost
+    with pytest.raises(UserError, match="planner: 'oracle' -> 'more'"):
+        prepare_run_dir(run, config(planner="more"), resume=True)
+    assert [r.task for r in prepare_run_dir(run, config(tasks=["a"]), resume=True)] == ["a"]
+
+
+def test_run_folder_lock_refuses_a_second_writer_and_dies_with_its_holder(tmp_path: Path) -> None:
+    with locked_run_dir(tmp_path):
+        with pytest.raises(RunFolderBusy, match=rf"being written by pid {os.getpid()} on "):
+            with locked_run_dir(tmp_path):
+                pass
+    holder = subprocess.Popen([sys.executable, "-c", (
+        "import sys, time; from pathlib import Path; from more_agent.eval.runlock import locked_run_dir\n"
+        "with locked_run_dir(Path(sys.argv[1])):\n    print('locked', flush=True); time.sleep(60)"
+    ), str(tmp_path)], stdout=subprocess.PIPE, text=True)
+    assert holder.stdout.readline().strip() == "locked"
+    with pytest.raises(RunFolderBusy, match=f"pid {holder.pid}"):
+        with locked_run_dir(tmp_path):
+            pass
+    holder.kill()  # kill -9: the OS releases the lock
+    holder.wait()
+    with locked_run_dir(tmp_path):
+        pass
+
+
+def test_retire_retryable_moves_them_aside(tmp_path: Path) -> None:
+    records = [rec("a"), rec("b").model_copy(update={"error": "LLM error", "retryable": True}), rec("c")]
+    write(tmp_path / "episodes.jsonl", records)
+    kept = retire_retryable(tmp_path, read_records(tmp_path))
+    assert [r.task for r in kept] == ["a", "c"] == [r.task for r in read_records(tmp_path)]
+    assert [r.task for r in read_records(tmp_path / "retried.jsonl")] == ["b"]
 
 
 def test_pending_matches_unset_scene_to_any_scene() -> None:
@@ -93,3 +137,10 @@ def test_redact_and_dirname() -> None:
     assert redact("openai:gpt-4o?api_key=sk-123&base=x") == "openai:gpt-4o?api_key=***&base=x"
     assert redact(None) is None
     assert episode_dirname("a/b", None, 3, "more") == "a_b__auto__s3__more"
+
+
+def test_pending_knows_a_scene_file_by_the_name_inside() -> None:
+    tiny = str(Path(__file__).parents[1] / "fixtures" / "tiny_scene.json")
+    spec = EpisodeSpec(task="a", scene=tiny, seed=0)
+    assert pending([spec], [rec("a", 0, "tiny")]) == []
+    assert pending([spec], [rec("a", 0, "Rs_int")]) == [spec]

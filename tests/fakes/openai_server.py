@@ -3,7 +3,7 @@
 Each POST to ``/v1/chat/completions`` takes the next script item: a :class:`Reply` (text answer with
 usage), a :class:`Status` (HTTP error, optional ``retry-after``), a :class:`Delay` (wait, then serve
 another item; makes clients time out), :class:`Raw` (any body) or :class:`Close` (drop the connection
-without answering).
+without answering) or :class:`Reset` (abort the connection with a TCP reset).
 A plain string in a script is a Reply. Requests are recorded in ``server.requests``. Binds to
 127.0.0.1 on a free port; use it as a context manager::
 
@@ -14,6 +14,8 @@ A plain string in a script is a Reply. Requests are recorded in ``server.request
 from __future__ import annotations
 
 import json
+import socket
+import struct
 import threading
 import time
 from collections import deque
@@ -65,7 +67,12 @@ class Close:
     """Drop the connection without sending a response."""
 
 
-ScriptItem = Reply | Status | Delay | Raw | Close
+@dataclass(frozen=True)
+class Reset:
+    """Abort the connection with a TCP reset (``SO_LINGER`` 0): the client sees ECONNRESET."""
+
+
+ScriptItem = Reply | Status | Delay | Raw | Close | Reset
 
 
 @dataclass(frozen=True)
@@ -184,6 +191,9 @@ class _Handler(BaseHTTPRequestHandler):
         elif isinstance(item, Raw):
             self._send(item.status, item.body, item.content_type)
         elif isinstance(item, Close):
+            self.close_connection = True
+        elif isinstance(item, Reset):
+            self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
             self.close_connection = True
         elif isinstance(item, Status):
             headers = {"retry-after": f"{item.retry_after:g}"} if item.retry_after is not None else {}
