@@ -11,9 +11,12 @@ SmolLM2-135M-Instruct; response cache off, so every answer is generated). Every 
   validator (a known skill, room and object) without a re-ask.
 
 One JSON line per task and a summary line; ``s_per_step`` is one high-level step's wall time (sense,
-room labels, filter, plan, act), ``llm_share`` the part of it spent in the model.
+room labels, filter, plan, act), ``cpu_s_per_step`` the CPU time this process used in it (less
+affected by other load on the machine; ``load_avg`` is the 1-minute load at the start and the end),
+``llm_share`` the part of the wall time spent in the model. ``threads`` are llama.cpp's threads for
+generation and for prompts (its default: half the cores and all of them).
 
-    python benchmarks/local_llm.py [--llm llamacpp:smollm2] [--tasks putting_shopping_away ...] [--steps 8]
+    python benchmarks/local_llm.py [--llm llamacpp:smollm2] [--tasks putting_shopping_away ...] [--steps 3] [--threads N]
 """
 
 from __future__ import annotations
@@ -132,13 +135,14 @@ def run_task(task: str, client: MeasuredClient, steps: int, seed: int) -> dict[s
     planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, f"llamacpp:{client.model}"))
     first_call = len(client.calls)
     planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
-    step_s, llm_s = [], []
+    step_s, cpu_s, llm_s = [], [], []
     for _ in range(steps):
-        t0, waited = time.perf_counter(), planner.llm_seconds
+        t0, c0, waited = time.perf_counter(), time.process_time(), planner.llm_seconds
         planner.observe()
         action = planner.decide()
         planner.execute(action)
         step_s.append(time.perf_counter() - t0)
+        cpu_s.append(time.process_time() - c0)
         llm_s.append(planner.llm_seconds - waited)
         if action.is_done:
             break
@@ -148,6 +152,7 @@ def run_task(task: str, client: MeasuredClient, steps: int, seed: int) -> dict[s
         "task": task, "scene": scene, "seed": seed, "steps": len(step_s),
         "actions": [f"{a.name}({', '.join(a.arguments)}){'' if a.ok else ' failed'}" for a in planner.history],
         "s_per_step": {"median": round(statistics.median(step_s), 2), "max": round(max(step_s), 2)},
+        "cpu_s_per_step": {"median": round(statistics.median(cpu_s), 2), "max": round(max(cpu_s), 2)},
         "llm_share": round(sum(llm_s) / sum(step_s), 3),
         **summary(calls), "by_purpose": by_purpose,
     }
@@ -157,10 +162,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--llm", default="llamacpp:smollm2", help="a llamacpp: spec (GGUF path or bundled name)")
     parser.add_argument("--tasks", nargs="+", default=list(DEFAULT_TASKS))
-    parser.add_argument("--steps", type=int, default=8)
+    parser.add_argument("--steps", type=int, default=3)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--threads", type=int, default=None, help="llama.cpp threads (default: llama.cpp's choice)")
     args = parser.parse_args(argv)
-    config = load_llm_config(overrides={"cache_mode": CacheMode.OFF})
+    load_start = round(os.getloadavg()[0], 1)
+    config = load_llm_config(overrides={"cache_mode": CacheMode.OFF, "llamacpp_n_threads": args.threads})
     client = MeasuredClient(make_client(args.llm, config))
     t0 = time.perf_counter()
     client.backend.llama()
@@ -172,7 +179,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     steps = [r["s_per_step"]["median"] for r in rows]  # type: ignore[index]
     print(json.dumps({
         "summary": True, "llm": args.llm, "model": client.model, "n_ctx": client.backend.n_ctx,
-        "threads": client.backend.llama().n_threads, "cpus": os.cpu_count(), "load_s": round(load_s, 2),
+        "threads": [client.backend.llama().n_threads, client.backend.llama().n_threads_batch], "cpus": os.cpu_count(),
+        "load_avg": [load_start, round(os.getloadavg()[0], 1)], "load_s": round(load_s, 2),
         "s_per_step_median_of_tasks": round(statistics.median(steps), 2), **summary(client.calls),
     }), flush=True)
     return 0

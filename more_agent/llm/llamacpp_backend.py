@@ -52,13 +52,20 @@ def trained_context(metadata: dict[str, str]) -> int | None:
     return int(value) if value else None
 
 
+def _token_text(llm: Any, token: int) -> str:
+    """The text of one (special) token, e.g. ``<|im_end|>``."""
+    return llm.detokenize([token], special=True).decode("utf-8", errors="replace")
+
+
 @functools.lru_cache(maxsize=2)
-def _load(path: Path, n_ctx: int, n_gpu_layers: int, seed: int | None) -> Any:
+def _load(path: Path, n_ctx: int, n_gpu_layers: int, seed: int | None, n_threads: int | None) -> Any:
     """A loaded ``llama_cpp.Llama`` using the GGUF's chat template; LLMConfigError if it has none."""
     llama_cpp = _import_llama_cpp()
     kwargs: dict[str, Any] = {"n_gpu_layers": n_gpu_layers, "verbose": False, "chat_format": GGUF_CHAT_FORMAT}
     if seed is not None:
         kwargs["seed"] = seed
+    if n_threads is not None:
+        kwargs["n_threads"] = kwargs["n_threads_batch"] = n_threads
     llm = llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, **kwargs)
     if CHAT_TEMPLATE_KEY not in llm.metadata:
         raise LLMConfigError(f"{path.name} holds no chat template ({CHAT_TEMPLATE_KEY}); use an instruct model's GGUF")
@@ -83,6 +90,7 @@ class LlamaCppBackend:
         n_ctx: int = 8192,
         n_gpu_layers: int = 0,
         seed: int | None = None,
+        n_threads: int | None = None,
         require_model: bool = True,
     ) -> None:
         """``require_model=False`` (replay runs, which never generate) skips the extra and file checks."""
@@ -95,6 +103,7 @@ class LlamaCppBackend:
         self._n_ctx = n_ctx
         self._n_gpu_layers = n_gpu_layers
         self._seed = seed
+        self._n_threads = n_threads
         self._formatter: Any = None
 
     @classmethod
@@ -102,12 +111,12 @@ class LlamaCppBackend:
         """A backend for the file, sized by the config."""
         return cls(
             model_path, n_ctx=config.llamacpp_n_ctx, n_gpu_layers=config.llamacpp_n_gpu_layers, seed=config.seed,
-            require_model=require_model,
+            n_threads=config.llamacpp_n_threads, require_model=require_model,
         )
 
     def llama(self) -> Any:
         """The loaded ``llama_cpp.Llama`` (loaded on first use, shared by backends of the same file and settings)."""
-        return _load(self.model_path.resolve(), self._n_ctx, self._n_gpu_layers, self._seed)
+        return _load(self.model_path.resolve(), self._n_ctx, self._n_gpu_layers, self._seed, self._n_threads)
 
     @property
     def n_ctx(self) -> int:
@@ -120,10 +129,9 @@ class LlamaCppBackend:
         if self._formatter is None:
             from llama_cpp.llama_chat_format import Jinja2ChatFormatter
 
-            token_text = lambda token: llm.detokenize([token], special=True).decode("utf-8", errors="replace")  # noqa: E731
             self._formatter = Jinja2ChatFormatter(
-                template=llm.metadata[CHAT_TEMPLATE_KEY], eos_token=token_text(llm.token_eos()),
-                bos_token=token_text(llm.token_bos()),
+                template=llm.metadata[CHAT_TEMPLATE_KEY], eos_token=_token_text(llm, llm.token_eos()),
+                bos_token=_token_text(llm, llm.token_bos()),
             )
         rendered = self._formatter(messages=list(messages))
         return len(llm.tokenize(rendered.prompt.encode("utf-8"), add_bos=not rendered.added_special, special=True))
