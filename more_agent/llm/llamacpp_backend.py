@@ -59,14 +59,17 @@ def _token_text(llm: Any, token: int) -> str:
 
 @functools.lru_cache(maxsize=2)
 def _load(path: Path, n_ctx: int, n_gpu_layers: int, seed: int | None, n_threads: int | None) -> Any:
-    """A loaded ``llama_cpp.Llama`` using the GGUF's chat template; LLMConfigError if it has none."""
+    """A loaded ``llama_cpp.Llama`` using the GGUF's chat template; LLMConfigError if it has none or is no model."""
     llama_cpp = _import_llama_cpp()
     kwargs: dict[str, Any] = {"n_gpu_layers": n_gpu_layers, "verbose": False, "chat_format": GGUF_CHAT_FORMAT}
     if seed is not None:
         kwargs["seed"] = seed
     if n_threads is not None:
         kwargs["n_threads"] = kwargs["n_threads_batch"] = n_threads
-    llm = llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, **kwargs)
+    try:
+        llm = llama_cpp.Llama(model_path=str(path), n_ctx=n_ctx, **kwargs)
+    except ValueError as e:  # llama-cpp-python's way of saying the file is not a model it can load
+        raise LLMConfigError(f"llama.cpp cannot load {path}: {e}") from None
     if CHAT_TEMPLATE_KEY not in llm.metadata:
         raise LLMConfigError(f"{path.name} holds no chat template ({CHAT_TEMPLATE_KEY}); use an instruct model's GGUF")
     trained = trained_context(llm.metadata)

@@ -5,6 +5,8 @@ Marked ``real_llm``: deselected by default, run by ``.ci/run`` after installing 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from pydantic import BaseModel
 
@@ -20,7 +22,7 @@ from more_agent.llm import (
     plan_messages,
     room_messages,
 )
-from more_agent.llm.errors import ContextLimitExceeded
+from more_agent.llm.errors import ContextLimitExceeded, LLMConfigError
 from more_agent.llm.llamacpp_backend import CHAT_TEMPLATE_KEY, GGUF_CHAT_FORMAT, LlamaCppBackend
 from more_agent.llm.local_models import bundled_model_path
 
@@ -77,3 +79,11 @@ def test_prompt_over_the_context_limit_is_a_clear_error_before_generating() -> N
 def test_context_is_capped_at_what_the_model_was_trained_for() -> None:
     backend, _ = _client(llamacpp_n_ctx=100_000)
     assert backend.n_ctx == 8192  # SmolLM2's training context, from its GGUF metadata
+
+
+def test_a_file_that_is_no_model_is_a_clear_error(tmp_path: Path) -> None:
+    bogus = tmp_path / "notes.gguf"
+    bogus.write_bytes(b"GGUF but not really a model")
+    client = make_client(f"llamacpp:{bogus}", LLMConfig(cache_mode=CacheMode.OFF))
+    with pytest.raises(LLMConfigError, match=r"llama.cpp cannot load .*notes.gguf"):
+        client.complete(CASES[0][0])
