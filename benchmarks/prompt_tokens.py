@@ -9,9 +9,11 @@ filtered text (MORE), so both sizes come from the same states. Unless ``--keep-d
 every door is opened at the start: the scripted explorer never opens doors, and the point is to
 see the prompt grow as the explored part of a large scene does.
 
-Tokens are estimated (no tokenizer is installed here): one token per word or punctuation mark,
-a rough stand-in for tiktoken's counts; the scene text alone is reported too, as the
-prompt's fixed part (instructions, skill API) does not change with filtering.
+Tokens are counted exactly by SmolLM2-135M-Instruct's tokenizer and chat template (llama.cpp) when
+the ``local`` extra is installed; otherwise they are estimated as one token per word or punctuation
+mark, a rough stand-in for tiktoken's counts. Each line's ``token_counts`` says which. The scene
+text alone is reported too, as the prompt's fixed part (instructions, skill API) does not change
+with filtering.
 ``overhead_s`` is the time of one step's sense + plan phases outside the LLM (graph build, room
 labels, language, filtering, parsing) on one core; ``act_s`` is the subpolicy's time (motion,
 rendering and fusing frames).
@@ -37,6 +39,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from more_agent.llm import plan_messages  # noqa: E402
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage  # noqa: E402
+from more_agent.llm.errors import LLMConfigError  # noqa: E402
+from more_agent.llm.llamacpp_backend import LlamaCppBackend  # noqa: E402
+from more_agent.llm.local_models import bundled_model_path  # noqa: E402
 from more_agent.planners.base import EpisodeContext  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402
 from more_agent.sim.goals import GoalChecker  # noqa: E402
@@ -51,13 +56,30 @@ _ENTRY = re.compile(r"([A-Za-z_]+(?: [A-Z]+)?)(?: \(x\d+\))?(?: \[([^\]]*)\])?")
 _ROOM_WORDS = {"kitchen": ("fridge", "oven", "stove", "dishwasher"), "bedroom": ("bed",), "bathroom": ("toilet", "bathtub")}
 
 
+def _tokenizer() -> LlamaCppBackend | None:
+    """The bundled SmolLM2 model when the ``local`` extra is installed (exact counts), else None (estimates)."""
+    try:
+        return LlamaCppBackend(bundled_model_path("smollm2"))
+    except LLMConfigError:
+        return None
+
+
+TOKENIZER = _tokenizer()
+TOKEN_COUNTS = ("exact: SmolLM2-135M-Instruct tokenizer and chat template (llama.cpp)" if TOKENIZER is not None
+                else "estimate: one per word or punctuation mark, 4 per message (no tokenizer installed)")
+
+
 def tokens(text: str) -> int:
-    """Estimated tokens of a text (see module docstring)."""
+    """Tokens of a text: exact with the tokenizer, else estimated (see module docstring)."""
+    if TOKENIZER is not None:
+        return len(TOKENIZER.llama().tokenize(text.encode("utf-8"), add_bos=False))
     return len(_TOKEN.findall(text))
 
 
 def prompt_tokens(messages: Sequence[ChatMessage]) -> int:
-    """Estimated tokens of a chat prompt (contents plus 4 per message, as chat formats add)."""
+    """Tokens of a chat prompt: exact (chat template applied) with the tokenizer, else contents plus 4 per message."""
+    if TOKENIZER is not None:
+        return TOKENIZER.prompt_tokens(messages)
     return sum(tokens(m["content"]) + 4 for m in messages)
 
 
@@ -149,7 +171,7 @@ def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True) -> dic
         rows[-1]["act_s"] = time.perf_counter() - t2
         if action.is_done:
             break
-    summary: dict[str, object] = {"scene": scene, "task": task, "seed": seed, "steps": len(rows),
+    summary: dict[str, object] = {"scene": scene, "task": task, "seed": seed, "steps": len(rows), "token_counts": TOKEN_COUNTS,
                                   "rooms_seen": len(planner.view.rooms) if planner.view else 0,
                                   "objects_seen": len(planner.graph.objects) if planner.graph else 0}
     for key in rows[0]:

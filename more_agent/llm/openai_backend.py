@@ -3,8 +3,10 @@
 Built on the ``openai`` SDK with its own retries switched off (``max_retries=0``): the retry loop
 here retries timeouts, connection drops, 429 (honouring ``retry-after``) and 5xx with exponential
 backoff and jitter, then raises the typed error of the last failure. A JSON schema is sent as
-``response_format`` when structured output is on; in ``auto`` mode a 400 to that request switches
-this backend to plain text for good (the client then extracts the JSON from the text).
+``response_format`` when structured output is on; in ``auto`` mode a rejection of that request (400,
+422, or a 5xx whose error names ``response_format``, as llama-cpp-python's server sends) switches
+this backend to the next way of sending it for good (:data:`SCHEMA_FORMATS`), and after the last to
+plain text (the client then extracts the JSON from the text).
 """
 
 from __future__ import annotations
@@ -31,11 +33,30 @@ from more_agent.llm.errors import (
     LLMTransportError,
     MissingAPIKey,
 )
+from more_agent.llm.grammar import bounded_schema
 
 if TYPE_CHECKING:
     import openai
 
 log = logging.getLogger(__name__)
+
+SCHEMA_FORMATS = ("json_schema", "json_object")
+"""Ways of sending a JSON schema, tried in this order in auto mode: OpenAI's ``json_schema``, then
+``{"type": "json_object", "schema": ...}``, the form llama-cpp-python's server compiles into a grammar
+(it refuses the first, with HTTP 500); that schema carries the grammar's length bounds (:mod:`more_agent.llm.grammar`)."""
+
+
+class _SchemaRejected(Exception):
+    """The server refused the way the schema was sent; ``error`` is its answer."""
+
+    def __init__(self, error: openai.APIStatusError) -> None:
+        super().__init__(str(error))
+        self.error = error
+
+
+def _rejects_response_format(error: openai.APIStatusError) -> bool:
+    """Whether an error status refuses the request's response_format: 400 or 422, or a 5xx that names it."""
+    return error.status_code in (400, 422) or (error.status_code >= 500 and "response_format" in str(error))
 
 
 def _retry_after_s(headers: Any) -> float | None:
@@ -78,8 +99,8 @@ class OpenAIBackend:
         self.backoff_initial_s = backoff_initial_s
         self.backoff_max_s = backoff_max_s
         self.structured_output = structured_output
-        self.schema_supported = structured_output is not StructuredOutput.NEVER
-        """False once the server rejected response_format (auto mode) or when it is off."""
+        self.schema_format: str | None = None if structured_output is StructuredOutput.NEVER else SCHEMA_FORMATS[0]
+        """How a schema is sent (one of SCHEMA_FORMATS); None when off or all were rejected (auto mode)."""
         self._sleep = sleep
         self._rng = rng or random.Random()
         self._sdk: openai.OpenAI | None = None
@@ -135,23 +156,35 @@ class OpenAIBackend:
         base = retry_after_s if retry_after_s is not None else self.backoff_initial_s * 2 ** (retry - 1)
         return min(self.backoff_max_s, base) * (1 + C.BACKOFF_JITTER * self._rng.random())
 
-    def _create(self, request: ChatRequest, with_schema: bool) -> Generation:
-        """One HTTP request, no retries."""
+    def _create(self, request: ChatRequest, schema_format: str | None) -> Generation:
+        """One HTTP request, no retries; the schema, if any, is sent the ``schema_format`` way.
+
+        Raises _SchemaRejected when the server refuses that way.
+        """
+        import openai
+
         extra: dict[str, Any] = {}
-        if with_schema and request.schema is not None:
+        if schema_format == "json_schema":
             extra["response_format"] = {
                 "type": "json_schema",
                 "json_schema": {"name": request.schema_name or "answer", "schema": request.schema, "strict": True},
             }
+        elif schema_format == "json_object":
+            extra["response_format"] = {"type": "json_object", "schema": bounded_schema(request.schema)}
         if request.seed is not None:
             extra["seed"] = request.seed
-        resp = self._client().chat.completions.create(
-            model=self.model,
-            messages=list(request.messages),  # type: ignore[arg-type]
-            temperature=request.temperature,
-            max_tokens=request.max_tokens,
-            **extra,
-        )
+        try:
+            resp = self._client().chat.completions.create(
+                model=self.model,
+                messages=list(request.messages),  # type: ignore[arg-type]
+                temperature=request.temperature,
+                max_tokens=request.max_tokens,
+                **extra,
+            )
+        except openai.APIStatusError as e:
+            if schema_format is not None and _rejects_response_format(e):
+                raise _SchemaRejected(e) from e
+            raise
         if not hasattr(resp, "choices"):
             raise LLMServerError(
                 f"{self.base_url} answered with something that is not a chat completion: {str(resp)[:200]!r}",
@@ -174,18 +207,26 @@ class OpenAIBackend:
         attempts = retries = 0
         while True:
             attempts += 1
-            with_schema = request.schema is not None and self.schema_supported
+            schema_format = self.schema_format if request.schema is not None else None
             retry_after: float | None = None
             error: LLMTransportError
             try:
-                gen = self._create(request, with_schema)
+                gen = self._create(request, schema_format)
                 return Generation(gen.text, gen.model, gen.prompt_tokens, gen.completion_tokens, attempts)
-            except openai.BadRequestError as e:
-                if with_schema and self.structured_output is StructuredOutput.AUTO:
-                    log.warning("%s rejected response_format (%s); parsing JSON from text now",
-                                self.base_url, clip(str(e), MAX_ERROR_CHARS))
-                    self.schema_supported = False
+            except _SchemaRejected as rejected:
+                e = rejected.error
+                if self.structured_output is StructuredOutput.AUTO:
+                    later = SCHEMA_FORMATS[SCHEMA_FORMATS.index(schema_format) + 1:]  # type: ignore[arg-type]
+                    self.schema_format = later[0] if later else None
+                    log.warning("%s rejected response_format %s (%s); now %s", self.base_url, schema_format,
+                                clip(str(e), MAX_ERROR_CHARS),
+                                f"sending {later[0]}" if later else "parsing JSON from text")
                     continue
+                raise LLMBadRequest(
+                    f"{self.base_url} rejected response_format {schema_format}: {e}", status_code=e.status_code,
+                    attempts=attempts,
+                ) from None
+            except openai.BadRequestError as e:
                 raise LLMBadRequest(
                     f"bad request to {self.model}: {e}", status_code=e.status_code, attempts=attempts
                 ) from None

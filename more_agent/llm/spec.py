@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -12,19 +11,20 @@ from more_agent.llm.cache import ResponseCache, check_cache_path
 from more_agent.llm.client import Backend, ChatClient
 from more_agent.llm.config import CacheMode, LLMConfig
 from more_agent.llm.errors import BadLLMSpec
+from more_agent.llm.local_models import BUNDLED_MODELS, gguf_path, is_bundled
 from more_agent.redaction import has_credentials
 
 BACKEND_KINDS = ("openai", "llamacpp")
-SPEC_HELP = "use openai:MODEL (e.g. openai:gpt-4o) or llamacpp:PATH.gguf"
+SPEC_HELP = f"use openai:MODEL (e.g. openai:gpt-4o), llamacpp:PATH.gguf or llamacpp:{'|'.join(BUNDLED_MODELS)}"
 
 
 class LLMSpec(BaseModel):
-    """Which LLM: a backend kind and a model name (openai) or GGUF file path (llamacpp)."""
+    """Which LLM: a backend kind and a model name (openai) or GGUF file path or bundled model name (llamacpp)."""
 
     model_config = ConfigDict(frozen=True)
 
     kind: Literal["openai", "llamacpp"] = Field(description="Backend family.")
-    model: str = Field(description="Model name at the endpoint, or path of the .gguf file.")
+    model: str = Field(description="Model name at the endpoint, or path of the .gguf file, or a bundled model's name.")
 
     def __str__(self) -> str:
         return f"{self.kind}:{self.model}"
@@ -50,8 +50,8 @@ def parse_llm_spec(spec: str) -> LLMSpec:
         raise BadLLMSpec(f"unknown LLM backend {kind!r} in {spec!r}{hint}; {SPEC_HELP}")
     if not model:
         raise BadLLMSpec(f"LLM spec {spec!r} names no model; {SPEC_HELP}")
-    if kind == "llamacpp" and not model.lower().endswith(".gguf"):
-        raise BadLLMSpec(f"llamacpp model {model!r} is not a .gguf file; {SPEC_HELP}")
+    if kind == "llamacpp" and not model.lower().endswith(".gguf") and not is_bundled(model):
+        raise BadLLMSpec(f"llamacpp model {model!r} is not a .gguf file nor a bundled model; {SPEC_HELP}")
     return LLMSpec(kind=kind, model=model)  # type: ignore[arg-type]
 
 
@@ -81,7 +81,9 @@ def make_backend(spec: LLMSpec, config: LLMConfig) -> Backend:
         return OpenAIBackend.from_config(spec.model, config, require_key=config.cache_mode is not CacheMode.REPLAY)
     from more_agent.llm.llamacpp_backend import LlamaCppBackend
 
-    return LlamaCppBackend.from_config(Path(spec.model).expanduser(), config)
+    return LlamaCppBackend.from_config(
+        gguf_path(spec.model), config, require_model=config.cache_mode is not CacheMode.REPLAY
+    )
 
 
 def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:

@@ -20,6 +20,7 @@ from more_agent.llm import (
     Unparseable,
     make_client,
 )
+from more_agent.llm.grammar import bounded_schema
 from tests.fakes.openai_server import Close, Delay, FakeOpenAIServer, Raw, Reply, Status
 
 MESSAGES = [ChatMessage(role="system", content="label rooms"), ChatMessage(role="user", content="fridge, oven, sink")]
@@ -142,12 +143,43 @@ def test_server_gone_is_a_connection_error(llm_config: LLMConfig) -> None:
 
 
 def test_rejected_response_format_falls_back_to_text(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:
-    fake_openai.push(Status(400, "response_format is not supported"), 'Answer: {"room": "kitchen"}', '{"room": "den"}')
+    fake_openai.push(Status(400, "response_format is not supported"), Status(400, "still not"),
+                     'Answer: {"room": "kitchen"}', '{"room": "den"}')
     client = make_client("openai:gpt-4o", llm_config.model_copy(update={"cache_mode": "off"}))
     assert client.complete(MESSAGES, schema=RoomLabelAnswer).parsed == {"room": "kitchen"}
     assert client.complete(MESSAGES, schema=RoomLabelAnswer).parsed == {"room": "den"}
-    sent = [("response_format" in r.body) for r in fake_openai.requests]
-    assert sent == [True, False, False]
+    sent = [r.body.get("response_format", {}).get("type") for r in fake_openai.requests]
+    assert sent == ["json_schema", "json_object", None, None]
+
+
+@pytest.mark.parametrize(
+    "refusal",
+    [
+        Status(422, "Input should be 'text' or 'json_object'"),
+        # llama-cpp-python's server answers an invalid request body with 500; its error names the field
+        Status(500, "1 validation error: ('body', 'response_format', 'type') Input should be 'text' or 'json_object'"),
+    ],
+)
+def test_refused_json_schema_is_sent_as_json_object_with_schema(
+    refusal: Status, fake_openai: FakeOpenAIServer, llm_config: LLMConfig
+) -> None:
+    fake_openai.push(refusal, '{"room": "kitchen"}', '{"room": "den"}')
+    client = make_client("openai:local", llm_config.model_copy(update={"cache_mode": "off"}))
+    assert client.complete(MESSAGES, schema=RoomLabelAnswer).parsed == {"room": "kitchen"}
+    assert client.complete(MESSAGES, schema=RoomLabelAnswer).parsed == {"room": "den"}
+    formats = [r.body["response_format"] for r in fake_openai.requests]
+    assert [f["type"] for f in formats] == ["json_schema", "json_object", "json_object"]
+    assert formats[1]["schema"] == bounded_schema(formats[0]["json_schema"]["schema"])  # with the grammar's bounds
+    assert formats[1]["schema"]["required"] == ["room"] and formats[1]["schema"]["properties"]["room"]["maxLength"] > 0
+
+
+def test_server_error_not_about_response_format_is_retried_with_it(
+    fake_openai: FakeOpenAIServer, llm_config: LLMConfig
+) -> None:
+    fake_openai.push(Status(500, "out of memory"), '{"room": "kitchen"}')
+    client = make_client("openai:local", llm_config.model_copy(update={"cache_mode": "off"}))
+    assert client.complete(MESSAGES, schema=RoomLabelAnswer).attempts == 2
+    assert [r.body["response_format"]["type"] for r in fake_openai.requests] == ["json_schema", "json_schema"]
 
 
 def test_structured_output_always_and_never(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:
