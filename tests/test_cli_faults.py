@@ -65,7 +65,7 @@ EXPECTED = {  # fault -> exit status of `more-agent run`, text in the output
     "reset": (0, "failure"),
     "slow": (0, "failure"),
     "injection": (0, "failure"),
-    "markup": (0, "rejected response_format (Error code: 400 - bad request [/x] [bold]markup[/bold])"),
+    "markup": (0, "rejected response_format json_schema (Error code: 400 - bad request [/x] [bold]markup[/bold])"),
 }
 
 
