@@ -18,7 +18,8 @@ def eval_(
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,
-    scene: Annotated[str | None, typer.Option(help="Scene for every task (default: each task's first matching scene).")] = None,
+    scene: Annotated[str | None, typer.Option(help="Scene for every task (default: drawn per episode among each task's suitable scenes).")] = None,
+    start: Annotated[str, typer.Option(help="Robot start: 'random' (anywhere reachable, the paper's) or 'task-room'.")] = "random",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -36,18 +37,24 @@ def eval_(
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, check_task_names, evaluate, resolve_tasks
     from more_agent.eval.report import load_runs, table_i_markdown, write_reports
     from more_agent.eval.store import RunConfig, redact
+    from more_agent.sim.start import check_start
+    from more_agent.sim.tasks import check_scene_suits
 
     if llm is not None and llm != redact(llm):
         raise UserError("--llm must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
     names = resolve_tasks(tasks)
+    check_start(start)
     if episode_fn is None:  # the real episode function runs BEHAVIOR-1K activities: check the names now
         check_task_names(names)
+        for name in names if scene is not None else ():
+            check_scene_suits(name, scene)
     config = RunConfig(
         planner=planner,
         llm=llm,
         tasks=names,
         seeds=list(range(seeds)),
         scene=scene,
+        start=start,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

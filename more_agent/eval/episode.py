@@ -21,12 +21,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
-from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
+from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
     from more_agent.sim.goals import GoalChecker, GoalStatus
+    from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
 
 log = logging.getLogger(__name__)
@@ -102,12 +103,13 @@ def run_episode(
     scope: dict[str, str] = {}
     try:
         t = time.perf_counter()
-        instance = instantiate(spec.task, spec.scene, spec.seed)
+        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start)
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
         world = instance.world
         record.scene, record.description = instance.scene, instance.description
+        record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
@@ -137,6 +139,20 @@ def run_episode(
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return record
+
+
+def world_stats(instance: TaskInstance) -> WorldStats:
+    """The world's size, clutter and start-to-task distance at the start of the episode."""
+    world, facts = instance.world, instance.start
+    task_objects = {n for s, n in instance.scope.items() if n in world.objects and s not in instance.virtual_scopes}
+    return WorldStats(
+        objects=sum(o.kind != "floor" for o in world.objects.values()),
+        task_objects=sum(world.objects[n].kind != "floor" for n in task_objects),
+        distractors=len(instance.distractors),
+        start_room=facts.start_room if facts else "",
+        task_rooms=list(facts.task_rooms) if facts else [],
+        start_to_task_m=facts.start_to_task_m if facts else None,
+    )
 
 
 def _run_steps(record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock) -> None:

@@ -95,7 +95,7 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
 def config_specs(config: RunConfig) -> list[EpisodeSpec]:
     """Every episode of a run: tasks x seeds, task-major."""
     return [
-        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm)
+        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start)
         for t in config.tasks
         for s in config.seeds
     ]

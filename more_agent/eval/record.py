@@ -135,7 +135,8 @@ class EpisodeSpec(BaseModel):
     model_config = ConfigDict(frozen=True)
 
     task: str = Field(description="BEHAVIOR-1K activity name.")
-    scene: str | None = Field(default=None, description="Scene name; None picks the first scene that suits the task.")
+    scene: str | None = Field(default=None, description="Scene name; None draws one with the seed among the task's suitable scenes.")
     seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
+    start: str = Field(default="random", description="Robot start: 'random' (anywhere reachable) or 'task-room'.")
