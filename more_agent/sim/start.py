@@ -2,24 +2,24 @@
 
 ``random_start`` draws a pose uniformly over the reachable free space of the whole scene: the cells
 of the ground-truth navigation grid (every door counted open, as the robot can open them) that lie
-in a connected component from which some task object can be reached, indoors or outdoors; the
-position is uniform within the drawn cell and the heading uniform. ``start_facts`` measures the
-start against the task: the rooms holding task objects, and the shortest path on that grid from the
-start to within reach of the nearest task object.
+in a connected component holding a base pose from which the magic actions reach some task object,
+indoors or outdoors; the position is uniform within the drawn cell and the heading uniform.
+``start_facts`` measures the start against the task: the rooms holding task objects, and the
+shortest path on that grid from the start to the nearest such pose.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import ndimage
-from skimage.graph import MCP_Geometric
 
 from more_agent.errors import UserError
-from more_agent.sim.actions import REACH_M, reach_box
-from more_agent.sim.navgrid import NavGrid, nav_grid
+from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
+from more_agent.sim.navgrid import NavGrid, nav_grid, shortest_path
 from more_agent.sim.world import World
 
 START_MODES = ("random", "task-room")
@@ -43,36 +43,25 @@ class StartFacts:
     """Path length from the start to within reach of the nearest task object; None when none is reachable."""
 
 
-def _cell_centres(grid: NavGrid) -> tuple[np.ndarray, np.ndarray]:
-    """(x, y) of every cell centre, each of the grid's shape."""
-    rows, cols = np.indices(grid.shape)
-    return grid.origin[0] + (cols + 0.5) * grid.resolution_m, grid.origin[1] + (rows + 0.5) * grid.resolution_m
-
-
-def _box_distance(grid: NavGrid, box: tuple[float, float, float, float]) -> np.ndarray:
-    """Horizontal distance of every cell centre to a footprint (0 inside it)."""
-    x, y = _cell_centres(grid)
-    x0, y0, x1, y1 = box
-    return np.hypot(np.maximum(np.maximum(x0 - x, x - x1), 0.0), np.maximum(np.maximum(y0 - y, y - y1), 0.0))
-
-
-def _reach_masks(world: World, grid: NavGrid, targets: Iterable[str]) -> list[np.ndarray]:
-    """Per target, the free cells from which it is within reach."""
-    return [grid.free & (_box_distance(grid, reach_box(world, t)) <= REACH_M) for t in targets]
+def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[tuple[int, int]]:
+    """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
+    cells = []
+    for t in targets:
+        x0, y0, x1, y1 = reach_box(world, t)
+        for poses in candidate_poses(world, t):
+            cells += [grid.to_cell(x, y) for x, y in poses
+                      if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)]
+    return cells
 
 
 def random_start(world: World, targets: list[str], rng: np.random.Generator) -> tuple[float, float, float] | None:
-    """A uniformly drawn (x, y, yaw) on the free space connected to some task object; None if there is none."""
+    """A uniformly drawn (x, y, yaw) on the free space connected to a pose that reaches a task object
+    (anywhere free when there is no target); None if there is none."""
     grid = nav_grid(world, all_doors_open=True)
     components, _ = ndimage.label(grid.free, structure=np.ones((3, 3)))
-    reach = np.zeros(grid.shape, dtype=bool)
-    for mask in _reach_masks(world, grid, targets):
-        reach |= mask
-    keep = np.unique(components[reach])
-    keep = keep[keep > 0]
-    if not targets:  # nothing to reach: anywhere free
-        keep = np.unique(components[components > 0])
-    cells = np.flatnonzero(np.isin(components, keep))
+    goals = approach_cells(world, grid, targets)
+    keep = np.unique([components[c] for c in goals]) if targets else np.unique(components)
+    cells = np.flatnonzero(np.isin(components, keep[keep > 0]))
     if len(cells) == 0:
         return None
     r, c = np.unravel_index(cells[rng.integers(len(cells))], grid.shape)
@@ -82,17 +71,11 @@ def random_start(world: World, targets: list[str], rng: np.random.Generator) -> 
 
 
 def start_to_task_m(world: World, targets: list[str]) -> float | None:
-    """Path length (doors open) from the robot to the nearest cell within reach of a task object."""
-    if not targets:
-        return None
+    """Path length (doors open) from the robot to the nearest pose from which a task object is within reach."""
     grid = nav_grid(world, all_doors_open=True)
-    start = grid.snap(world.robot.x, world.robot.y)
-    if start is None:
-        return None
-    costs = np.where(grid.free, 1.0, np.inf)
-    cum, _ = MCP_Geometric(costs).find_costs([start])
-    best = min((float(cum[m].min()) for m in _reach_masks(world, grid, targets) if m.any()), default=np.inf)
-    return round(best * grid.resolution_m, 3) if np.isfinite(best) else None
+    goals = [grid.to_xy(*c) for c in approach_cells(world, grid, targets)]
+    path = shortest_path(grid, (world.robot.x, world.robot.y), goals)
+    return round(path.length_m, 3) if path.found else None
 
 
 def task_rooms(world: World, targets: Iterable[str]) -> list[str]:
