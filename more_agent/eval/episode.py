@@ -131,7 +131,7 @@ def run_episode(
         _finish(record, goals.check(world), scope, planner)
     if out_dir is not None:
         t = time.perf_counter()
-        _write_map(record, world, Path(out_dir))
+        _write_map(record, world, Path(out_dir), set(scope.values()))
         clock.add("write", t)
     record.timings = clock.total()
     if record.llm_usage.calls:
@@ -199,7 +199,7 @@ def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], pl
     record.llm_usage = planner.llm_usage()
 
 
-def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
+def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path, labelled: set[str]) -> None:
     """The map picture (when the world was built); the record itself is written last, with final timings."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if world is None:
@@ -208,6 +208,6 @@ def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path) -> Non
 
     try:
         save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE,
-                            title=f"{record.task} ({record.scene}, {record.planner})")
+                            title=f"{record.task} ({record.scene}, {record.planner})", labelled=labelled)
     except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
         log.warning("could not draw %s: %s: %s", out_dir / MAP_FILE, type(e).__name__, e)

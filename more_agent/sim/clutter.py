@@ -155,6 +155,7 @@ class _RoomPlacer:
         self.area = np.array([_surface_area(world, s, rel) for s, rel in self.supports])
         self.full: set[tuple[int, str]] = set()
         """(support index, category) pairs known to have no room left for that category."""
+        self._fitting: dict[str, list[int]] = {}
 
     def place(self, name: str) -> bool:
         """Put item ``name`` on / in a support with room, or on the floor; False when nothing has room."""
@@ -164,8 +165,9 @@ class _RoomPlacer:
         return self._on_floor(obj)
 
     def _on_support(self, obj: WorldObject) -> bool:
-        fits = [i for i, (s, rel) in enumerate(self.supports)
-                if (i, obj.category) not in self.full and _fits(self.world, obj, s, rel)]
+        if obj.category not in self._fitting:  # one category, one size
+            self._fitting[obj.category] = [i for i, (s, rel) in enumerate(self.supports) if _fits(self.world, obj, s, rel)]
+        fits = [i for i in self._fitting[obj.category] if (i, obj.category) not in self.full]
         if not fits:
             return False
         p = self.area[fits] / self.area[fits].sum()

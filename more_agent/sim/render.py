@@ -295,7 +295,7 @@ def class_colors(class_names: list[str]) -> np.ndarray:
 
 
 class Renderer:
-    """Renders frames of a world through one camera; rebuilds the box grid only when ``world.version`` changes."""
+    """Renders frames of a world through one camera; rebuilds the box grid only when ``world.layout_version`` changes."""
 
     def __init__(self, camera: Camera | None = None) -> None:
         self.camera = camera or Camera()
@@ -307,9 +307,9 @@ class Renderer:
 
     def geometry(self, world: World) -> SceneGeometry:
         """The world's current drawable boxes and grid (cached per world object and version)."""
-        if self._geometry is None or self._world is not world or self._version != world.version:
+        if self._geometry is None or self._world is not world or self._version != world.layout_version:
             self._geometry = scene_geometry(world)
-            self._world, self._version = world, world.version
+            self._world, self._version = world, world.layout_version
         return self._geometry
 
     def render(self, world: World) -> Frame:

@@ -101,6 +101,9 @@ class World:
     robot: RobotState = field(default_factory=RobotState)
     class_names: list[str] = field(default_factory=lambda: list(STRUCTURAL_CLASSES))
     version: int = 0
+    layout_version: int = 0
+    """Increases on every change of an object (pose, support, open state); unlike ``version``, not
+    when the robot merely moves, so renderers rebuild their geometry only when it changed."""
     _labels_used: dict[str, int] = field(default_factory=dict, repr=False)
     """Category -> how many instance labels of it have been handed out."""
 
@@ -138,6 +141,7 @@ class World:
         self.semantic_id(obj.category)
         self.objects[obj.name] = obj
         self.version += 1
+        self.layout_version += 1
         return obj
 
     def semantic_id(self, category: str) -> int:
@@ -252,6 +256,7 @@ class World:
             raise ValueError(f"{name} is not openable")
         obj.is_open = is_open
         self.version += 1
+        self.layout_version += 1
 
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
@@ -262,6 +267,7 @@ class World:
         if self.robot.held == name:
             self.robot.held = None
         self.version += 1
+        self.layout_version += 1
 
     def place_if_room(self, name: str, parent: str, relation: Relation) -> bool:
         """Like ``place``, but only where a free slot exists; False (nothing changed) when there is none."""
@@ -272,6 +278,7 @@ class World:
         obj.parent, obj.relation, obj.room = parent, relation, support.room
         self._move_subtree(obj, slot)
         self.version += 1
+        self.layout_version += 1
         return True
 
     def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
@@ -282,6 +289,7 @@ class World:
         if self.robot.held == name:
             self.robot.held = None
         self.version += 1
+        self.layout_version += 1
 
     def pick(self, name: str) -> None:
         """Put item ``name`` in the robot's gripper, detached from its support (no precondition checks)."""
@@ -290,12 +298,15 @@ class World:
         self.robot.held = name
         self._carry()
         self.version += 1
+        self.layout_version += 1
 
     def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
         self.version += 1
+        if self.robot.held is not None:  # the held item moved along
+            self.layout_version += 1
 
     def _carry(self) -> None:
         """Move the held item (and what rests in / on it) to the gripper, ``CARRY_HEIGHT_M`` above the base."""
