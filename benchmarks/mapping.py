@@ -110,16 +110,21 @@ def run(size: int) -> dict:
             "peak_mb": round(peak_mb, 1), **counts, "frame_update_s": round(frame_update_s(), 5)}
 
 
-def run_scene(name: str) -> dict:
-    """Explore a BEHAVIOR-1K scene room by room from rendered frames; time fusion and the graph build."""
+def run_scene(name: str, items: bool = True) -> dict:
+    """Explore a BEHAVIOR-1K scene room by room from rendered frames; time fusion and the graph build.
+
+    With ``items`` the world holds the scene's own small objects (``sim.clutter``), as episodes do.
+    """
     from collections import Counter
 
     from more_agent.planners.policies import Embodiment
+    from more_agent.sim.clutter import add_distractors, clutter_rng
     from more_agent.sim.navgrid import nav_grid
     from more_agent.sim.scenes import get_scene
     from more_agent.sim.world import World
 
     world = World.from_scene(get_scene(name, 0))
+    n_items = len(add_distractors(world, clutter_rng(name, 0)).items) if items else 0
     for door in world.scene.doors:
         world.set_open(door.id, True)
     grid = nav_grid(world)
@@ -150,7 +155,7 @@ def run_scene(name: str) -> dict:
     region_rooms = [Counter(world.room_at(*graph.nav.node_xy[i]) for i in r.nav_nodes).most_common(1)[0][0]
                     for r in graph.regions.values() if r.nav_nodes]
     occ = graph.occupancy
-    return {"scene": name, "rooms": len(world.scene.rooms), "frames": len(fuse_times),
+    return {"scene": name, "rooms": len(world.scene.rooms), "items": n_items, "frames": len(fuse_times),
             "known_cells": int((occ.grid != 0).sum()) if occ is not None else 0,
             "frame_fuse_s_median": round(float(np.median(fuse_times[2:])), 5),
             "graph_build_s_median": round(float(np.median(builds)), 4), "graph_build_peak_mb": round(peak_mb, 1),
@@ -162,10 +167,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="600", help="cells per side, or 'all'")
     parser.add_argument("--scene", nargs="*", default=None, help="BEHAVIOR-1K scenes from rendered frames instead")
+    parser.add_argument("--no-items", action="store_true", help="scenes without their own small objects")
     args = parser.parse_args()
     if args.scene:
         for name in args.scene:
-            print(json.dumps(run_scene(name)), flush=True)
+            print(json.dumps(run_scene(name, items=not args.no_items)), flush=True)
         return
     for size in SIZES if args.size == "all" else (int(args.size),):
         print(json.dumps(run(size)), flush=True)

@@ -22,15 +22,18 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from more_agent.errors import UserError  # noqa: E402
+from more_agent.sim.clutter import add_distractors, clutter_rng  # noqa: E402
 from more_agent.sim.navgrid import nav_grid  # noqa: E402
 from more_agent.sim.render import Renderer  # noqa: E402
 from more_agent.sim.scenes import get_scene, scene_names  # noqa: E402
 from more_agent.sim.world import World  # noqa: E402
 
 
-def time_scene(name: str, frames: int, rng: np.random.Generator, renderer: Renderer) -> dict[str, object]:
-    """Median and 90th percentile frame time over ``frames`` random free poses in one scene."""
+def time_scene(name: str, frames: int, rng: np.random.Generator, renderer: Renderer, items: bool = True) -> dict[str, object]:
+    """Median and 90th percentile frame time over ``frames`` random free poses in one scene (with its
+    own small objects as items unless ``items`` is False)."""
     world = World.from_scene(get_scene(name, 0))
+    n_items = len(add_distractors(world, clutter_rng(name, 0)).items) if items else 0
     grid = nav_grid(world)
     rows, cols = np.nonzero(grid.free)
     picks = rng.integers(len(rows), size=frames)
@@ -44,7 +47,7 @@ def time_scene(name: str, frames: int, rng: np.random.Generator, renderer: Rende
         times.append((time.perf_counter() - t0) * 1000)
     x0, y0, x1, y1 = world.scene.bounds
     return {
-        "benchmark": "render_frame", "scene": name, "boxes": geometry.n_boxes, "area_m2": round((x1 - x0) * (y1 - y0), 1),
+        "benchmark": "render_frame", "scene": name, "items": n_items, "boxes": geometry.n_boxes, "area_m2": round((x1 - x0) * (y1 - y0), 1),
         "frames": frames, "median_ms": round(float(np.median(times)), 3), "p90_ms": round(float(np.percentile(times, 90)), 3),
     }
 
@@ -54,6 +57,7 @@ def main() -> None:
     parser.add_argument("--scenes", nargs="*", default=None, help="scene names (default: all 51)")
     parser.add_argument("--frames", type=int, default=50, help="frames timed per scene")
     parser.add_argument("--seed", type=int, default=0, help="seed of the pose sampling")
+    parser.add_argument("--no-items", action="store_true", help="scenes without their own small objects")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     renderer = Renderer()
@@ -61,7 +65,7 @@ def main() -> None:
     renderer.render(warm)  # compile or load the kernels outside the timings
     for name in args.scenes or scene_names():
         try:
-            row = time_scene(name, args.frames, rng, renderer)
+            row = time_scene(name, args.frames, rng, renderer, items=not args.no_items)
         except (RuntimeError, UserError) as e:  # a scene the generator cannot lay out: say so, go on
             print(f"{name}: {e}", file=sys.stderr)
             continue

@@ -32,9 +32,9 @@ from more_agent.sim.world import Relation, World, WorldObject, floor_name
 MAX_PER_CATEGORY = 32
 """Most items of one category per room (a store lists 1,411 apples: a few full shelf rows stay)."""
 
-MAX_PER_ROOM = 400
-"""Most items per room in all; with the furniture a grocery store then holds well over 500 objects
-while the render and scene-graph budgets hold (docs/scenes.md)."""
+MAX_PER_ROOM = 480
+"""Most items per room in all; with its furniture every grocery store then holds over 500 objects
+while the render and scene-graph budgets hold (docs/tasks.md)."""
 
 FLOOR_SHARE = 0.08
 """Share of the items put on the floor (boxes and bags by a shelf, a book dropped by a sofa)."""
@@ -92,13 +92,23 @@ def room_item_counts(scene: str) -> dict[str, dict[str, int]]:
             category = key.rsplit("-", 1)[0]
             if category in sized and _is_loose(category):
                 listed[category] = listed.get(category, 0) + n
-        counts = {c: min(n, MAX_PER_CATEGORY) for c, n in listed.items()}
-        total = sum(counts.values())
-        if total > MAX_PER_ROOM:
-            scale = MAX_PER_ROOM / total
-            counts = {c: max(1, int(n * scale)) for c, n in counts.items()}
+        counts = _scale_to(MAX_PER_ROOM, {c: min(n, MAX_PER_CATEGORY) for c, n in sorted(listed.items())})
         if counts:
             out[room] = counts
+    return out
+
+
+def _scale_to(total: int, counts: dict[str, int]) -> dict[str, int]:
+    """Counts scaled down in proportion to sum to ``total`` (largest remainders round up; each at
+    least 1) when they sum to more; unchanged otherwise."""
+    listed = sum(counts.values())
+    if listed <= total:
+        return counts
+    exact = {c: n * total / listed for c, n in counts.items()}
+    out = {c: max(1, int(x)) for c, x in exact.items()}
+    by_remainder = sorted(counts, key=lambda c: (out[c] - exact[c], c))
+    for c in by_remainder[: max(total - sum(out.values()), 0)]:
+        out[c] += 1
     return out
 
 
