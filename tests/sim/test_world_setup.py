@@ -70,7 +70,8 @@ def test_unknown_start_names_the_choices() -> None:
 def test_store_counts_follow_bddl_up_to_the_caps() -> None:
     counts = room_item_counts("grocery_store_cafe")
     store = counts["grocery_store_0"]
-    assert store["apple"] == MAX_PER_CATEGORY and sum(store.values()) == MAX_PER_ROOM  # 6,586 listed
+    assert sum(store.values()) == MAX_PER_ROOM  # 6,586 listed
+    assert store["apple"] == max(store.values()) <= MAX_PER_CATEGORY and min(store.values()) >= 1
     assert counts["dining_room_0"] == {"bowl": 12, "magazine": 12, "beaker": 8, "teacup": 4}  # under the caps: as listed
     assert "bathroom_0" not in room_item_counts("grocery_store_asian")  # it lists only door handles
     assert room_item_counts("my_hand_written_scene") == {}
