@@ -142,7 +142,7 @@ def instantiate(
             instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors)
         except InstantiationError as e:
             if scene is not None:
-                raise
+                raise InstantiationError(f"{e} (scene {name}, seed {seed}); choose another --seed or --scene") from None
             failures.append(f"{name}: {e}")
             continue
         instance.timings.update(parse=t_parse, scene=t_scene, total=time.perf_counter() - t0)
