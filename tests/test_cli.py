@@ -44,7 +44,7 @@ def test_default_run_without_llm_says_so_first_and_solves_with_the_oracle(tmp_pa
         (["run", TASK, "--scene", "Rs_itn"], "closest: Rs_int"),
         (["run", TASK, "--planner", "mroe"], "closest: more"),
         (["run", TASK, "--scene", "office_large"], "scene 'office_large' does not suit task 'putting_shopping_away'"),
-        (["run", TASK, "--start", "kitchen"], "unknown start 'kitchen'; use --start with one of: random, task-room"),
+        (["run", TASK, "--start", "kitchen"], "unknown start 'kitchen'; use --start with one of: random, random-area, task-room"),
         (["run", TASK, "--planner", "more"], "needs an LLM"),
         (["run", TASK, "--planner", "more", "--llm", "gpt-4o"], "openai:"),
     ],

@@ -139,4 +139,4 @@ class EpisodeSpec(BaseModel):
     seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
-    start: str = Field(default="random", description="Robot start: 'random' (anywhere reachable) or 'task-room'.")
+    start: str = Field(default="random", description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.")

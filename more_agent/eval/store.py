@@ -32,7 +32,7 @@ class RunConfig(BaseModel):
     tasks: list[str] = Field(default_factory=list, description="Task names, in run order.")
     seeds: list[int] = Field(default_factory=list, description="Seeds run for every task.")
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
-    start: str = Field(default="random", description="Robot start of every episode: 'random' or 'task-room'.")
+    start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")

@@ -170,10 +170,11 @@ def instantiate_in_scene(
     clutter = add_distractors(world, clutter_rng(scene.name, seed)) if distractors else Clutter()
     t_clutter = time.perf_counter() - t0 - t_bind
     targets = builder.task_objects()
-    if start == "random":
-        builder.place_robot_at_random(targets, np.random.default_rng([seed, zlib.crc32(definition.name.encode()), 0x57]))
-    else:
+    if start == "task-room":
         builder.place_robot()
+    else:
+        start_rng = np.random.default_rng([seed, zlib.crc32(definition.name.encode()), 0x57])
+        builder.place_robot_at_random(targets, start_rng, by_room=start == "random")
     t_place = time.perf_counter() - t0 - t_bind - t_clutter
     instance = TaskInstance(
         task=definition.name, scene=scene.name, seed=seed, world=world, description="",
@@ -389,8 +390,8 @@ class _Builder:
         solid = sorted({n for n in names if self.world.objects[n].kind != "floor"})
         return solid or sorted(set(names))
 
-    def place_robot_at_random(self, targets: list[str], rng: np.random.Generator) -> None:
-        pose = random_start(self.world, targets, rng)
+    def place_robot_at_random(self, targets: list[str], rng: np.random.Generator, *, by_room: bool) -> None:
+        pose = random_start(self.world, targets, rng, by_room=by_room)
         if pose is None:
             raise InstantiationError(f"no free spot for the robot from which {', '.join(targets[:3])} can be reached")
         self.world.set_robot_pose(*pose)
@@ -445,7 +446,7 @@ def _verify_init(instance: TaskInstance) -> None:
         text = literal_text(lit)
         if lit[0] == "inroom" or text in unsupported:
             continue
-        if instance.start_mode == "random" and lit[0] == "ontop" and instance.scope.get(lit[1]) == ROBOT_NAME:
+        if instance.start_mode != "task-room" and lit[0] == "ontop" and instance.scope.get(lit[1]) == ROBOT_NAME:
             continue  # the random start replaces the task's own start room (paper Sec. IV-A)
         head = compile_state([lit], backend, scope=dict(scope), object_map=instance.definition.objects,
                              generate_ground_options=False)[0]

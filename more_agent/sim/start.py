@@ -22,9 +22,13 @@ from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
 from more_agent.sim.navgrid import NavGrid, nav_grid, shortest_path
 from more_agent.sim.world import World
 
-START_MODES = ("random", "task-room")
-"""``random``: anywhere reachable (the paper's protocol, default); ``task-room``: a free spot in the room
-of the task's ``(ontop agent floor)`` literal (the behaviour before random starts)."""
+MIN_ROOM_FREE_M2 = 1.0
+"""A room counts for the per-room start draw when it has at least this much reachable free floor."""
+
+START_MODES = ("random", "random-area", "task-room")
+"""``random`` (default): a reachable room drawn uniformly, then a uniform pose in it; ``random-area``:
+a pose uniform over all reachable free space, so large rooms (stores, gardens) take most starts;
+``task-room``: a free spot in the room of the task's ``(ontop agent floor)`` literal."""
 
 
 def check_start(start: str) -> None:
@@ -43,6 +47,12 @@ class StartFacts:
     """Path length from the start to within reach of the nearest task object; None when none is reachable."""
 
 
+def _cell_centres(grid: NavGrid) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) of every cell centre, each of the grid's shape."""
+    rows, cols = np.indices(grid.shape)
+    return grid.origin[0] + (cols + 0.5) * grid.resolution_m, grid.origin[1] + (rows + 0.5) * grid.resolution_m
+
+
 def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[tuple[int, int]]:
     """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
     cells = []
@@ -54,14 +64,28 @@ def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[
     return cells
 
 
-def random_start(world: World, targets: list[str], rng: np.random.Generator) -> tuple[float, float, float] | None:
+def random_start(
+    world: World, targets: list[str], rng: np.random.Generator, *, by_room: bool = False,
+) -> tuple[float, float, float] | None:
     """A uniformly drawn (x, y, yaw) on the free space connected to a pose that reaches a task object
-    (anywhere free when there is no target); None if there is none."""
+    (anywhere free when there is no target); None if there is none.
+
+    With ``by_room`` the room is drawn first, uniformly among the rooms with at least
+    ``MIN_ROOM_FREE_M2`` of such free space, then the position uniformly within it.
+    """
     grid = nav_grid(world, all_doors_open=True)
     components, _ = ndimage.label(grid.free, structure=np.ones((3, 3)))
     goals = approach_cells(world, grid, targets)
     keep = np.unique([components[c] for c in goals]) if targets else np.unique(components)
-    cells = np.flatnonzero(np.isin(components, keep[keep > 0]))
+    free = np.isin(components, keep[keep > 0])
+    if by_room:
+        min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
+        x, y = _cell_centres(grid)
+        rooms = [m for r in world.scene.rooms
+                 if (m := free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])).sum() >= min_cells]
+        if rooms:
+            free = rooms[rng.integers(len(rooms))]
+    cells = np.flatnonzero(free)
     if len(cells) == 0:
         return None
     r, c = np.unravel_index(cells[rng.integers(len(cells))], grid.shape)

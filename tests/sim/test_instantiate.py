@@ -30,7 +30,7 @@ def _check_init(inst: TaskInstance) -> None:
         text = literal_text(lit)
         if lit[0] == "inroom" or text in inst.unsupported_literals:
             continue
-        if inst.start_mode == "random" and inst.scope.get(lit[1]) == ROBOT_NAME:
+        if inst.start_mode != "task-room" and inst.scope.get(lit[1]) == ROBOT_NAME:
             continue  # the random start replaces (ontop agent floor)
         head = compile_state([lit], backend, scope=dict(scope), object_map=inst.definition.objects,
                              generate_ground_options=False)[0]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from more_agent.sim.instantiate import instantiate, instantiate_in_scene
 from more_agent.sim.navgrid import nav_grid, shortest_path
 from more_agent.sim.render import Renderer, instance_table
 from more_agent.sim.scene import load_scene
+from more_agent.sim.start import random_start
 from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, episode_scenes, suitable_scenes
 
 KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
@@ -55,6 +57,22 @@ def test_random_start_is_reachable_seeded_and_measured() -> None:
     assert rooms == {"kitchen_0", "corridor_0"}  # both rooms get drawn
 
 
+def test_random_start_draws_rooms_uniformly_random_area_draws_by_area() -> None:
+    inst = instantiate("putting_shopping_away", "Rs_int", seed=0, start="task-room", distractors=False)
+    world, rng = inst.world, np.random.default_rng(0)
+    targets = [n for n in inst.scope.values() if n in world.objects and world.get(n).kind != "floor"]
+
+    def shares(by_room: bool) -> Counter[str]:
+        rooms = Counter(world.room_at(*random_start(world, targets, rng, by_room=by_room)[:2]) for _ in range(600))
+        return Counter({r: n / 600 for r, n in rooms.items()})
+
+    per_room, per_area = shares(True), shares(False)
+    n = len(per_room)
+    assert n >= 3 and all(0.5 / n < s < 1.6 / n for s in per_room.values())
+    largest = max(world.scene.rooms, key=lambda r: (r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1])).id
+    assert per_area[largest] > 1.3 / n > per_room[largest]
+
+
 def test_task_room_start_keeps_the_tasks_own_room() -> None:
     for seed in range(4):
         inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=seed, start="task-room")
@@ -62,7 +80,7 @@ def test_task_room_start_keeps_the_tasks_own_room() -> None:
 
 
 def test_unknown_start_names_the_choices() -> None:
-    with pytest.raises(UserError, match="unknown start 'kitchen'; use --start with one of: random, task-room"):
+    with pytest.raises(UserError, match="unknown start 'kitchen'; use --start with one of: random, random-area, task-room"):
         instantiate("putting_shopping_away", start="kitchen")
 
 
