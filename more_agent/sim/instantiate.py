@@ -14,8 +14,12 @@ Steps (all deterministic for a given task, scene and seed):
    ``touching`` on the floor beside the other object, or on the same support when that object is
    not on a floor. Openable containers that receive items are closed unless an ``open`` literal
    says otherwise; then ``open`` / ``not open`` literals set articulation.
-5. The robot stands at a free spot of the room of its ``ontop agent floor`` literal.
-6. Every supported init literal is evaluated through our bddl backend; a false one raises
+5. The scene's own small objects are added as distractor items (``sim.clutter``).
+6. The robot starts at a random reachable pose (``sim.start``), or with ``start="task-room"`` at a
+   free spot of the room of its ``ontop agent floor`` literal.
+7. Only the instances the description names get their labels now; every other instance is
+   labelled when first observed (``World.observe``).
+8. Every supported init literal is evaluated through our bddl backend; a false one raises
    ``InstantiationError`` naming it. Literals that do not apply to rearrangement (cooked,
    covered, filled, ...) and literals over virtual scopes are kept in ``unsupported_literals``.
 """
