@@ -104,7 +104,7 @@ class World:
     layout_version: int = 0
     """Increases on every change of an object (pose, support, open state); unlike ``version``, not
     when the robot merely moves, so renderers rebuild their geometry only when it changed."""
-    _labels_used: dict[str, int] = field(default_factory=dict, repr=False)
+    _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
     """Category -> how many instance labels of it have been handed out."""
 
     # -- construction -------------------------------------------------------------------------
