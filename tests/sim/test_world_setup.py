@@ -14,7 +14,7 @@ from more_agent.sim.clutter import MAX_PER_CATEGORY, MAX_PER_ROOM, add_distracto
 from more_agent.sim.instantiate import instantiate, instantiate_in_scene
 from more_agent.sim.navgrid import nav_grid, shortest_path
 from more_agent.sim.render import Renderer, instance_table
-from more_agent.sim.scene import load_scene
+from more_agent.sim.scene import load_scene, save_scene
 from more_agent.sim.start import random_start
 from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, episode_scenes, suitable_scenes
 
@@ -153,3 +153,12 @@ def test_assign_labels_names_the_rest_after_the_reserved() -> None:
     assert world.get("fridge_0").label == "fridge A"
     cabinets = sorted(o.label for o in world.objects.values() if o.category == "bottom_cabinet")
     assert cabinets == ["bottom_cabinet A", "bottom_cabinet B"]
+
+
+def test_a_forced_scene_that_cannot_hold_the_task_says_what_to_change(tmp_path: Path) -> None:
+    scene = load_scene(KITCHEN)
+    scene = scene.model_copy(update={"furniture": [f for f in scene.furniture if f.category != "fridge"]})
+    path = tmp_path / "no_fridge.json"
+    save_scene(scene, path)
+    with pytest.raises(UserError, match=r"inroom electric_refrigerator.*seed 3\); choose another --seed or --scene$"):
+        instantiate("putting_shopping_away", str(path), seed=3)
