@@ -29,7 +29,9 @@ from more_agent.sim.scenes import get_scene, scene_names  # noqa: E402
 from more_agent.sim.world import World  # noqa: E402
 
 
-def time_scene(name: str, frames: int, rng: np.random.Generator, renderer: Renderer, items: bool = True) -> dict[str, object]:
+def time_scene(
+    name: str, frames: int, rng: np.random.Generator, renderer: Renderer, items: bool = True,
+) -> dict[str, object]:
     """Median and 90th percentile frame time over ``frames`` random free poses in one scene (with its
     own small objects as items unless ``items`` is False)."""
     world = World.from_scene(get_scene(name, 0))

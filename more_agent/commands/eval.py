@@ -18,8 +18,12 @@ def eval_(
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,
-    scene: Annotated[str | None, typer.Option(help="Scene for every task (default: drawn per episode among each task's suitable scenes).")] = None,
-    start: Annotated[str, typer.Option(help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over reachable floor) or 'task-room'.")] = "random",
+    scene: Annotated[str | None, typer.Option(
+        help="Scene for every task (default: drawn per episode among each task's suitable scenes)."
+    )] = None,
+    start: Annotated[str, typer.Option(
+        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+    )] = "random",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")

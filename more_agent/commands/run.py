@@ -60,9 +60,13 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
 def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
     planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
-    scene: Annotated[str | None, typer.Option(help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes).")] = None,
+    scene: Annotated[str | None, typer.Option(
+        help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
+    )] = None,
     seed: Annotated[int, typer.Option(help="Seed of the scene draw, scene generation, instantiation and start pose.")] = 0,
-    start: Annotated[str, typer.Option(help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over reachable floor) or 'task-room'.")] = "random",
+    start: Annotated[str, typer.Option(
+        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+    )] = "random",
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,

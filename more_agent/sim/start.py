@@ -81,8 +81,9 @@ def random_start(
     if by_room:
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
         x, y = _cell_centres(grid)
-        rooms = [m for r in world.scene.rooms
-                 if (m := free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])).sum() >= min_cells]
+        in_room = [free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
+                   for r in world.scene.rooms]
+        rooms = [m for m in in_room if m.sum() >= min_cells]
         if rooms:
             free = rooms[rng.integers(len(rooms))]
     cells = np.flatnonzero(free)
