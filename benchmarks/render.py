@@ -1,6 +1,6 @@
 """Frame rendering time per scene: one JSON object per scene on stdout.
 
-Each line: scene, number of drawn boxes, scene area, frames timed, and the median / 90th percentile
+Each line: scene, items (the scene's own small objects, unless ``--no-items``), number of drawn boxes, scene area, frames timed, and the median / 90th percentile
 milliseconds of one 256x256 frame (depth + semantic + instance + RGB) on one core, from robot poses
 drawn at random among the free cells of the navigation grid. Scenes are generated with seed 0;
 the numba kernels are compiled (or loaded from cache) before timing.
@@ -50,7 +50,8 @@ def time_scene(
         cpu.append((time.process_time() - c0) * 1000)
     x0, y0, x1, y1 = world.scene.bounds
     return {
-        "benchmark": "render_frame", "scene": name, "items": n_items, "boxes": geometry.n_boxes, "area_m2": round((x1 - x0) * (y1 - y0), 1),
+        "benchmark": "render_frame", "scene": name, "items": n_items, "boxes": geometry.n_boxes,
+        "area_m2": round((x1 - x0) * (y1 - y0), 1),
         "frames": frames, "median_ms": round(float(np.median(times)), 3), "p90_ms": round(float(np.percentile(times, 90)), 3),
         "cpu_median_ms": round(float(np.median(cpu)), 3),
     }
