@@ -1,7 +1,8 @@
 """Frame rendering time per scene: one JSON object per scene on stdout.
 
-Each line: scene, items (the scene's own small objects, unless ``--no-items``), number of drawn boxes, scene area, frames timed, and the median / 90th percentile
-milliseconds of one 256x256 frame (depth + semantic + instance + RGB) on one core, from robot poses
+Each line: scene, items (the scene's own small objects, unless ``--no-items``), number of drawn
+boxes, scene area, frames timed, and the median / 90th percentile milliseconds of one 256x256
+frame (depth + semantic + instance + RGB) on one core (and the median CPU ms), from robot poses
 drawn at random among the free cells of the navigation grid. Scenes are generated with seed 0;
 the numba kernels are compiled (or loaded from cache) before timing.
 
