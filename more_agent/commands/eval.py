@@ -18,7 +18,12 @@ def eval_(
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,
-    scene: Annotated[str | None, typer.Option(help="Scene for every task (default: each task's first matching scene).")] = None,
+    scene: Annotated[str | None, typer.Option(
+        help="Scene for every task (default: drawn per episode among each task's suitable scenes)."
+    )] = None,
+    start: Annotated[str, typer.Option(
+        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+    )] = "random",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -48,8 +53,9 @@ def eval_(
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
     from more_agent.eval.report import load_runs, table_i_markdown, write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
-
     from more_agent.llm import parse_llm_spec
+    from more_agent.sim.start import check_start
+    from more_agent.sim.tasks import check_scene_suits
 
     if viewer and episode_fn is not None:
         raise UserError("--viewer runs its own episode function: give either --viewer or --episode-fn")
@@ -59,13 +65,13 @@ def eval_(
     if llm is not None:
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
+    check_start(start)
     if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
-        from more_agent.sim.scenes import get_scene
 
         check_task_names(names)
-        if scene is not None:
-            get_scene(scene)
+        for name in names if scene is not None else ():
+            check_scene_suits(name, scene)
         make_planner(planner, llm)  # an unknown planner or a missing LLM fails here, before any episode
     config = RunConfig(
         planner=planner,
@@ -73,6 +79,7 @@ def eval_(
         tasks=names,
         seeds=list(range(seeds)),
         scene=scene,
+        start=start,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

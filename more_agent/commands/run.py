@@ -31,11 +31,11 @@ RUNS_DIR = Path("runs")
 
 
 def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Path:
-    """``runs/<task>-<scene>-<seed>-<planner>``; the scene is the task's first suitable one when not given."""
+    """``runs/<task>-<scene>-<seed>-<planner>``; the scene is the one the seed draws when not given."""
     if scene is None:
-        from more_agent.sim.tasks import suitable_scenes
+        from more_agent.sim.tasks import draw_scenes
 
-        scenes = suitable_scenes(task)
+        scenes = draw_scenes(task, seed)
         scene = scenes[0] if scenes else "auto"
     name = re.sub(r"[^A-Za-z0-9_.\-]", "_", f"{task}-{Path(scene).stem}-{seed}-{planner}")
     return RUNS_DIR / name
@@ -68,8 +68,13 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
 def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
     planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
-    scene: Annotated[str | None, typer.Option(help="Scene name or scene .json file (default: the task's first suitable scene).")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of scene generation and task instantiation.")] = 0,
+    scene: Annotated[str | None, typer.Option(
+        help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
+    )] = None,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation, instantiation and start pose.")] = 0,
+    start: Annotated[str, typer.Option(
+        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+    )] = "random",
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
@@ -85,9 +90,13 @@ def run(
     from more_agent.viz.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
 
-    from more_agent.sim.tasks import load_task
+    from more_agent.sim.start import check_start
+    from more_agent.sim.tasks import check_scene_suits, load_task
 
     load_task(task)  # an unknown task fails first, with the closest names
+    check_start(start)
+    if scene is not None:
+        check_scene_suits(task, scene)
     if planner is None:
         planner = default_planner(llm)
         if planner == DEFAULT_PLANNER:
@@ -95,7 +104,7 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm)
+    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start)
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,

@@ -39,17 +39,22 @@ def list_(
 @user_errors_exit_2
 def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
-    scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: the first suitable).")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of scene generation and instantiation.")] = 0,
+    scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: drawn with the seed).")] = None,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation and instantiation.")] = 0,
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
     from more_agent.sim.instantiate import instantiate, literal_text
-    from more_agent.sim.tasks import load_task, suitable_scenes
+    from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, load_task, suitable_scenes
 
     definition = load_task(task)
     scenes = suitable_scenes(task)
     console.print(task, style="bold", highlight=False, markup=False)
     console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False, markup=False)
+    drawn = draw_scenes(task, seed)
+    console.print(f"episode scenes ({len(drawn)}, {', '.join(EXCLUDED_SCENES)} left out); "
+                  f"drawn for seed {seed}: {drawn[0] if drawn else '-'}", highlight=False, markup=False)
+    if scene is not None:
+        check_scene_suits(task, scene)
     console.print("goal:", highlight=False)
     for lit in definition.goal:
         console.print(f"  {literal_text(lit)}", highlight=False, markup=False)

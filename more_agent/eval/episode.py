@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
-from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
+from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.eval.timeline import TimelineWriter
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
@@ -31,6 +31,7 @@ from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
     from more_agent.sim.goals import GoalChecker, GoalStatus
+    from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
 
 log = logging.getLogger(__name__)
@@ -113,12 +114,13 @@ def run_episode(
     scope: dict[str, str] = {}
     try:
         t = time.perf_counter()
-        instance = instantiate(spec.task, spec.scene, spec.seed)
+        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start)
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
         world = instance.world
         record.scene, record.description = instance.scene, instance.description
+        record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
@@ -141,7 +143,7 @@ def run_episode(
         _finish(record, goals.check(world), scope, planner)
     if out_dir is not None:
         t = time.perf_counter()
-        _write_map(record, world, Path(out_dir))
+        _write_map(record, world, Path(out_dir), set(scope.values()))
         clock.add("write", t)
     record.timings = clock.total()
     if record.llm_usage.calls:
@@ -149,6 +151,20 @@ def run_episode(
     if out_dir is not None:
         (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return record
+
+
+def world_stats(instance: TaskInstance) -> WorldStats:
+    """The world's size, clutter and start-to-task distance at the start of the episode."""
+    world, facts = instance.world, instance.start
+    task_objects = {n for s, n in instance.scope.items() if n in world.objects and s not in instance.virtual_scopes}
+    return WorldStats(
+        objects=sum(o.kind != "floor" for o in world.objects.values()),
+        task_objects=sum(world.objects[n].kind != "floor" for n in task_objects),
+        distractors=len(instance.distractors),
+        start_room=facts.start_room if facts else "",
+        task_rooms=list(facts.task_rooms) if facts else [],
+        start_to_task_m=facts.start_to_task_m if facts else None,
+    )
 
 
 def ended_abnormally(record: EpisodeRecord) -> bool:
@@ -171,10 +187,10 @@ _PNG_END = b"IEND\xaeB`\x82"
 
 def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
-    rebuilt from (task, scene, seed) in its initial state (objects where they started)."""
+    rebuilt from (task, scene, seed, start) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
-    _write_map(record, instantiate(spec.task, spec.scene, spec.seed).world, out_dir)
+    _write_map(record, instantiate(spec.task, spec.scene, spec.seed, start=spec.start).world, out_dir)
 
 
 def _run_steps(
@@ -227,7 +243,7 @@ def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], pl
     record.llm_usage = planner.llm_usage()
 
 
-def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path) -> None:
+def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path, labelled: set[str]) -> None:
     """The map picture (when the world was built); the record itself is written last, with final timings."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if world is None:
@@ -236,6 +252,6 @@ def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path) -> Non
 
     try:
         save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE,
-                            title=f"{record.task} ({record.scene}, {record.planner})")
+                            title=f"{record.task} ({record.scene}, {record.planner})", labelled=labelled)
     except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
         log.warning("could not draw %s: %s: %s", out_dir / MAP_FILE, type(e).__name__, e)

@@ -113,7 +113,7 @@ def _is_file(path: Path) -> bool:
 def config_specs(config: RunConfig) -> list[EpisodeSpec]:
     """Every episode of a run: tasks x seeds, task-major."""
     return [
-        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm)
+        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start)
         for t in config.tasks
         for s in config.seeds
     ]

@@ -99,6 +99,7 @@ class EpisodeRecord(BaseModel):
     seed: int = Field(description="Seed of scene generation and task instantiation.")
     planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'.")
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
+    start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
     description: str = Field(default="", description="Language description the planner received.")
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
     all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
@@ -131,7 +132,10 @@ class EpisodeRecord(BaseModel):
     @classmethod
     def for_spec(cls, spec: EpisodeSpec, **fields: object) -> EpisodeRecord:
         """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
-        return cls(task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, **fields)
+        return cls(
+            task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, start=spec.start,
+            **fields,
+        )
 
 
 class EpisodeSpec(BaseModel):
@@ -140,7 +144,8 @@ class EpisodeSpec(BaseModel):
     model_config = ConfigDict(frozen=True)
 
     task: str = Field(description="BEHAVIOR-1K activity name.")
-    scene: str | None = Field(default=None, description="Scene name; None picks the first scene that suits the task.")
+    scene: str | None = Field(default=None, description="Scene name; None draws one with the seed among the task's suitable scenes.")
     seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
+    start: str = Field(default="random", description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.")

@@ -37,6 +37,7 @@ class RunConfig(BaseModel):
     tasks: list[str] = Field(default_factory=list, description="Task names, in run order.")
     seeds: list[int] = Field(default_factory=list, description="Seeds run for every task.")
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
+    start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
@@ -48,7 +49,7 @@ def redact(spec: str | None) -> str | None:
     return None if spec is None else redact_text(spec)
 
 
-MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "episode_fn")
+MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "episode_fn")
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 
@@ -62,7 +63,9 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     """The run configuration ``records`` imply, for a folder whose ``run.json`` is missing."""
     planners = sorted({r.planner for r in records})
     llms = sorted({str(r.llm) for r in records})
+    starts = sorted({r.start for r in records})
     return config.model_copy(update={
+        "start": starts[0] if len(starts) == 1 else ",".join(starts),
         "planner": planners[0] if len(planners) == 1 else ",".join(planners),
         "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
         "tasks": sorted({r.task for r in records} | set(config.tasks)),
@@ -251,7 +254,7 @@ def prepare_run_dir(
     """Create or reopen a run directory and return the records already in it.
 
     Without ``resume`` a non-empty directory is refused. With ``resume`` the planner, LLM, tasks,
-    seeds, scene and episode function must match the stored ``run.json`` (or, when it is missing,
+    seeds, scene, start mode and episode function must match the stored ``run.json`` (or, when it is missing,
     the records), unless ``allow_mixed``; a torn last line is truncated.
     """
     run_dir = Path(run_dir)

@@ -165,7 +165,8 @@ class OraclePlanner:
         self._intent: Literal | None = None
         """The literal the held item was grasped for."""
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
-        self._last_feedback: dict[tuple[str, tuple[str, ...]], str] = {}
+        self._last_failure: dict[tuple[str, tuple[str, ...]], tuple[str, str | None]] = {}
+        """Per action, the feedback and blocking door of its last failure."""
         self._observed: set[str] = set()
         self._body = Embodiment.for_episode(context)
         self._graph_dir = context.out_dir if context.save_graph else None
@@ -218,7 +219,7 @@ class OraclePlanner:
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
-            why = self._last_feedback[key]
+            why = self._last_failure[key][0]
             note = f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
             return HighLevelAction(DONE, gave_up=note)
         return action
@@ -364,9 +365,11 @@ class OraclePlanner:
                 self._observed.update(o.name for o in world.descendants(arg) if world.is_observable(o.name))
         else:
             key = (action.name, action.arguments)
-            # A different failure (another door in the way) is progress; the same one twice is not.
-            self._failures[key] = self._failures[key] + 1 if self._last_feedback.get(key) == result.feedback else 1
-            self._last_feedback[key] = result.feedback
+            # A different failure (another door in the way, even one not yet seen, whose feedback
+            # names it by category only) is progress; the same one twice is not.
+            failure = (result.feedback, result.blocking)
+            self._failures[key] = self._failures[key] + 1 if self._last_failure.get(key) == failure else 1
+            self._last_failure[key] = failure
             if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR:
                 self._door = result.blocking
         return result

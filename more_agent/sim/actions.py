@@ -93,7 +93,9 @@ def _fail(reason: FailureReason, feedback: str, blocking: str | None = None) -> 
 
 
 def _label(obj: WorldObject) -> str:
-    return obj.label or obj.name
+    """How feedback names an object: its label, or its bare category before it has been observed
+    (a world name such as 'apple_o17' would reveal an instance the robot has not seen)."""
+    return obj.label or obj.category
 
 
 def reach_box(world: World, name: str) -> tuple[float, float, float, float]:

@@ -14,8 +14,12 @@ Steps (all deterministic for a given task, scene and seed):
    ``touching`` on the floor beside the other object, or on the same support when that object is
    not on a floor. Openable containers that receive items are closed unless an ``open`` literal
    says otherwise; then ``open`` / ``not open`` literals set articulation.
-5. The robot stands at a free spot of the room of its ``ontop agent floor`` literal.
-6. Every supported init literal is evaluated through our bddl backend; a false one raises
+5. The scene's own small objects are added as distractor items (``sim.clutter``).
+6. The robot starts at a random reachable pose (``sim.start``), or with ``start="task-room"`` at a
+   free spot of the room of its ``ontop agent floor`` literal.
+7. Only the instances the description names get their labels now; every other instance is
+   labelled when first observed (``World.observe``).
+8. Every supported init literal is evaluated through our bddl backend; a false one raises
    ``InstantiationError`` naming it. Literals that do not apply to rearrangement (cooked,
    covered, filled, ...) and literals over virtual scopes are kept in ``unsupported_literals``.
 """
@@ -24,6 +28,7 @@ from __future__ import annotations
 
 import re
 import time
+import zlib
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -33,8 +38,19 @@ from bddl.condition_evaluation import compile_state
 from more_agent.errors import UserError
 from more_agent.sim import catalog
 from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
+from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
+from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.scene import Scene
-from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal, load_task, scope_synset, suitable_scenes
+from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
+from more_agent.sim.tasks import (
+    TaskDefinition,
+    category_phrase,
+    check_scene_suits,
+    describe_goal,
+    draw_scenes,
+    load_task,
+    scope_synset,
+)
 from more_agent.sim.world import World, WorldObject, floor_name
 
 PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
@@ -45,14 +61,6 @@ ROBOT_CLEARANCE_M = 0.35
 
 FLOOR_MARGIN_M = 0.1
 """Gap kept between a floor item and walls, furniture and other floor items."""
-
-DOOR_KEEPOUT_M = 0.6
-"""Floor items stay this far from door openings so doors stay passable."""
-
-SAMPLE_TRIES = 400
-"""Random draws before falling back to a raster scan of the room."""
-
-RASTER_STEP_M = 0.05
 
 GROUND_CATEGORIES = {"floor": "floors", "driveway": "driveway", "lawn": "lawn", "carpet": "carpet"}
 """World ground class -> BEHAVIOR category; scopes of these bind to a room's floor object."""
@@ -85,6 +93,12 @@ class TaskInstance:
     """Init literals (BDDL form, scope names) not applied because rearrangement does not model them."""
     timings: dict[str, float]
     definition: TaskDefinition = field(repr=False)
+    start_mode: str = "random"
+    """How the robot's start was chosen (``start.START_MODES``)."""
+    distractors: list[str] = field(default_factory=list)
+    """World names of the scene's own small objects added as items (``sim.clutter``)."""
+    start: StartFacts | None = None
+    """Start room, task rooms and start-to-task path length at the start."""
 
     def scope_objects(self) -> dict[str, ScopeObject]:
         """The filled bddl scope: every entry a ``ScopeObject``."""
@@ -95,31 +109,57 @@ class TaskInstance:
         }
 
     def label(self, scope: str) -> str:
-        """Readable name of a scope's object: its label ('apple A'), a floor's room or 'the robot'."""
+        """Readable name of a scope's object: its label ('apple A') or, before it is observed, its
+        category; a floor's room or 'the robot'."""
         return _readable(self.world, self.scope[scope])
 
 
-def instantiate(task: str, scene: str | None = None, seed: int = 0) -> TaskInstance:
-    """Instantiate ``task`` in a scene by name (default: its first suitable scene), generated with ``seed``."""
+def instantiate(
+    task: str, scene: str | None = None, seed: int = 0, *, start: str = "random", distractors: bool = True,
+) -> TaskInstance:
+    """Instantiate ``task`` with ``seed`` in a scene generated with that seed.
+
+    Without ``scene``, the scene is drawn with the seed among the task's suitable ones
+    (``tasks.draw_scenes``; the next in the draw is tried when one cannot hold the task); a named
+    scene must suit the task (scene .json files are taken as they are). ``start`` is one of
+    ``START_MODES``; ``distractors`` adds the scene's own small objects (``sim.clutter``).
+    """
     t0 = time.perf_counter()
+    check_start(start)
     definition = load_task(task)
     t_parse = time.perf_counter() - t0
     if scene is None:
-        scenes = suitable_scenes(task)
-        if not scenes:
+        candidates = draw_scenes(task, seed)
+        if not candidates:
             raise InstantiationError(f"no BEHAVIOR-1K scene suits task {task!r} (its inroom requirements match none)")
-        scene = scenes[0]
+    else:
+        candidates = [scene]
+        check_scene_suits(task, scene)
     from more_agent.sim.scenes import get_scene
 
-    t1 = time.perf_counter()
-    scene_obj = get_scene(scene, seed)
-    t_scene = time.perf_counter() - t1
-    instance = instantiate_in_scene(definition, scene_obj, seed)
-    instance.timings.update(parse=t_parse, scene=t_scene, total=time.perf_counter() - t0)
-    return instance
+    failures: list[str] = []
+    for name in candidates:
+        t1 = time.perf_counter()
+        scene_obj = get_scene(name, seed)
+        t_scene = time.perf_counter() - t1
+        try:
+            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors)
+        except InstantiationError as e:
+            if scene is not None:
+                raise InstantiationError(f"{e} (scene {name}, seed {seed}); choose another --seed or --scene") from None
+            failures.append(f"{name}: {e}")
+            continue
+        instance.timings.update(parse=t_parse, scene=t_scene, total=time.perf_counter() - t0)
+        return instance
+    raise InstantiationError(
+        f"task {task!r} cannot be placed in any of its {len(candidates)} scenes with seed {seed} "
+        f"(first: {failures[0]}); choose another --seed or a --scene"
+    )
 
 
-def instantiate_in_scene(definition: TaskDefinition | str, scene: Scene, seed: int = 0) -> TaskInstance:
+def instantiate_in_scene(
+    definition: TaskDefinition | str, scene: Scene, seed: int = 0, *, start: str = "random", distractors: bool = True,
+) -> TaskInstance:
     """Instantiate a task in a given ``Scene`` object (hand-built scenes included)."""
     if isinstance(definition, str):
         definition = load_task(definition)
@@ -131,32 +171,43 @@ def instantiate_in_scene(definition: TaskDefinition | str, scene: Scene, seed: i
     builder.create_items()
     t_bind = time.perf_counter() - t0
     builder.place_items()
-    builder.place_robot()
-    world.assign_labels()
-    t_place = time.perf_counter() - t0 - t_bind
+    clutter = add_distractors(world, clutter_rng(scene.name, seed)) if distractors else Clutter()
+    t_clutter = time.perf_counter() - t0 - t_bind
+    targets = builder.task_objects()
+    if start == "task-room":
+        builder.place_robot()
+    else:
+        start_rng = np.random.default_rng([seed, zlib.crc32(definition.name.encode()), 0x57])
+        builder.place_robot_at_random(targets, start_rng, by_room=start == "random")
+    t_place = time.perf_counter() - t0 - t_bind - t_clutter
     instance = TaskInstance(
         task=definition.name, scene=scene.name, seed=seed, world=world, description="",
         scope=builder.scope, virtual_scopes=sorted(builder.virtual), unsupported_literals=builder.unsupported,
-        timings={}, definition=definition,
+        timings={}, definition=definition, start_mode=start, distractors=clutter.items,
+        start=start_facts(world, targets),
     )
     _verify_init(instance)
     instance.description = task_description(instance)
-    instance.timings.update(bind=t_bind, place=t_place, instantiate=time.perf_counter() - t0)
+    instance.timings.update(bind=t_bind, place=t_place, clutter=t_clutter, instantiate=time.perf_counter() - t0)
     return instance
 
 
 def task_description(instance: TaskInstance) -> str:
-    """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal."""
+    """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal.
+
+    The instances it names get their labels here, before the episode, so that the description and
+    the scene text agree; every other instance is labelled when first observed.
+    """
     text = instance.definition.paper_description
     if text is not None:
         return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: _scope_phrase(instance, m.group(1)), text)
-    return describe_goal(instance.definition.goal, instance.label)
+    return describe_goal(instance.definition.goal, lambda s: _readable(instance.world, instance.scope[s], reserve=True))
 
 
 def _scope_phrase(instance: TaskInstance, scope: str) -> str:
     """A scope's label; a scope the paper names but bddl 3.6 lacks reads as 'the <category>'."""
     if scope in instance.scope:
-        return instance.label(scope)
+        return _readable(instance.world, instance.scope[scope], reserve=True)
     return f"the {category_phrase(scope_synset(scope))}"
 
 
@@ -336,6 +387,19 @@ class _Builder:
         self.world.place_on_floor_at(name, floor, xy)
 
     # -- step 5: robot ------------------------------------------------------------------------------
+    def task_objects(self) -> list[str]:
+        """World names of the task's objects the robot may go to: items, furniture and doors of the scope
+        (floors only when the scope holds nothing else)."""
+        names = [n for s, n in self.scope.items() if s not in self.virtual and n != ROBOT_NAME]
+        solid = sorted({n for n in names if self.world.objects[n].kind != "floor"})
+        return solid or sorted(set(names))
+
+    def place_robot_at_random(self, targets: list[str], rng: np.random.Generator, *, by_room: bool) -> None:
+        pose = random_start(self.world, targets, rng, by_room=by_room)
+        if pose is None:
+            raise InstantiationError(f"no free spot for the robot from which {', '.join(targets[:3])} can be reached")
+        self.world.set_robot_pose(*pose)
+
     def place_robot(self) -> None:
         floor = self._default_floor()
         room = self.world.objects[floor].room
@@ -364,7 +428,8 @@ def _item_name(scope: str, taken: set[str]) -> str:
     return f"{lemma}_n{sense}_{index}_{k}"
 
 
-def _readable(world: World, name: str) -> str:
+def _readable(world: World, name: str, *, reserve: bool = False) -> str:
+    """How a description names an object; with ``reserve`` an unlabelled one gets its label now."""
     if name == ROBOT_NAME:
         return "the robot"
     obj = world.objects.get(name)
@@ -373,55 +438,7 @@ def _readable(world: World, name: str) -> str:
     if obj.kind == "floor":
         room = world.scene.room(obj.room) if obj.room else None
         return f"the {room.type.replace('_', ' ')} floor" if room else "the floor"
-    return obj.label or obj.name
-
-
-def free_floor_spot(
-    world: World, room_id: str | None, half: np.ndarray, rng: np.random.Generator,
-    near: WorldObject | None = None, exclude: str | None = None, bounds: tuple[float, float, float, float] | None = None,
-) -> tuple[float, float] | None:
-    """A random (x, y) in a room (or in ``bounds``) where a box of half extents ``half`` overlaps no
-    furniture, wall, door opening or floor item; with ``near``, close beside that object's box."""
-    room = world.scene.room(room_id) if room_id else world.scene.rooms[0]
-    x0, y0, x1, y1 = bounds or room.bounds
-    lo, hi = np.array([x0, y0]) + half, np.array([x1, y1]) - half
-    if np.any(lo >= hi):
-        return None
-    boxes = _floor_obstacles(world, exclude)
-    if near is not None:
-        nlo = np.maximum(lo, near.center[:2] - near.size[:2] / 2 - 2 * half - 0.1)
-        nhi = np.minimum(hi, near.center[:2] + near.size[:2] / 2 + 2 * half + 0.1)
-        if np.all(nlo < nhi):
-            lo, hi = nlo, nhi
-    for _ in range(SAMPLE_TRIES):
-        p = rng.uniform(lo, hi)
-        if not np.any(np.all((boxes[:, :2] < p + half) & (boxes[:, 2:] > p - half), axis=1)):
-            return float(p[0]), float(p[1])
-    # Crowded room: scan a raster of candidate centres and draw among the free ones.
-    gx, gy = np.meshgrid(np.arange(lo[0], hi[0], RASTER_STEP_M), np.arange(lo[1], hi[1], RASTER_STEP_M))
-    pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
-    blocked = np.zeros(len(pts), dtype=bool)
-    for box in boxes:
-        blocked |= np.all((box[:2] < pts + half) & (box[2:] > pts - half), axis=1)
-    free = pts[~blocked]
-    if len(free) == 0:
-        return None
-    p = free[rng.integers(len(free))]
-    return float(p[0]), float(p[1])
-
-
-def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
-    """(n, 4) array of footprints (xmin, ymin, xmax, ymax) a floor spot must avoid."""
-    rows = [w.bounds for w in world.scene.walls]
-    for obj in world.objects.values():
-        if obj.name == exclude or obj.kind == "floor":
-            continue
-        if obj.kind == "item" and not (obj.parent and world.objects[obj.parent].kind == "floor"):
-            continue
-        x0, y0, x1, y1 = obj.footprint()
-        pad = DOOR_KEEPOUT_M if obj.kind == "door" else 0.0
-        rows.append((x0 - pad, y0 - pad, x1 + pad, y1 + pad))
-    return np.asarray(rows, dtype=float).reshape(-1, 4)
+    return world.reserve_label(name) if reserve else world.display_label(name)
 
 
 def _verify_init(instance: TaskInstance) -> None:
@@ -433,6 +450,8 @@ def _verify_init(instance: TaskInstance) -> None:
         text = literal_text(lit)
         if lit[0] == "inroom" or text in unsupported:
             continue
+        if instance.start_mode != "task-room" and lit[0] == "ontop" and instance.scope.get(lit[1]) == ROBOT_NAME:
+            continue  # the random start replaces the task's own start room (paper Sec. IV-A)
         head = compile_state([lit], backend, scope=dict(scope), object_map=instance.definition.objects,
                              generate_ground_options=False)[0]
         if not head.evaluate():

@@ -16,6 +16,7 @@ negations and that instantiates in its first suitable scene).
 from __future__ import annotations
 
 import json
+import zlib
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -24,8 +25,10 @@ from importlib import resources
 from typing import Any
 
 import networkx as nx
+import numpy as np
 
 from more_agent.errors import UserError, unknown_name_error
+from more_agent.sim import catalog
 
 REARRANGE_PREDICATES = frozenset({"inside", "ontop", "open"})
 """Goal predicates of the behavior-rearrange set."""
@@ -163,6 +166,36 @@ def suitable_scenes(task: str) -> list[str]:
     """Scenes whose rooms hold what the task's ``inroom`` literals need, sorted by name."""
     load_task(task)
     return list(task_data()["tasks"][task]["scenes"])
+
+
+EXCLUDED_SCENES = ("restaurant_diner", "school_gym")
+"""Scenes the paper leaves out of its protocol (supplementary S.1)."""
+
+
+def episode_scenes(task: str) -> list[str]:
+    """The scenes an episode of ``task`` is drawn from: its suitable scenes less ``EXCLUDED_SCENES``
+    (all suitable ones when the exclusion would leave none), sorted."""
+    scenes = suitable_scenes(task)
+    kept = [s for s in scenes if s not in EXCLUDED_SCENES]
+    return kept or scenes
+
+
+def draw_scenes(task: str, seed: int) -> list[str]:
+    """``episode_scenes(task)`` in a random order drawn with (task, seed): the first is the episode's
+    scene, uniformly drawn; the others are fallbacks, in order, should it fail to hold the task."""
+    scenes = episode_scenes(task)
+    rng = np.random.default_rng([seed, zlib.crc32(task.encode())])
+    return [scenes[i] for i in rng.permutation(len(scenes))]
+
+
+def check_scene_suits(task: str, scene: str) -> None:
+    """Raise a UserError when a BEHAVIOR-1K scene named for ``task`` does not suit it (scene files pass)."""
+    if scene.endswith(".json"):
+        return
+    suitable = suitable_scenes(task)
+    if scene not in suitable and scene in catalog.scene_names():
+        shown = ", ".join(suitable[:8]) + (f" (+{len(suitable) - 8})" if len(suitable) > 8 else "")
+        raise UserError(f"scene {scene!r} does not suit task {task!r}; choose --scene among: {shown or 'none'}")
 
 
 # -- scene matching (what bddl's knowledge base does, on the room object lists) ---------------------

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 import string
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -100,6 +101,11 @@ class World:
     robot: RobotState = field(default_factory=RobotState)
     class_names: list[str] = field(default_factory=lambda: list(STRUCTURAL_CLASSES))
     version: int = 0
+    layout_version: int = 0
+    """Increases on every change of an object (pose, support, open state); unlike ``version``, not
+    when the robot merely moves, so renderers rebuild their geometry only when it changed."""
+    _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
+    """Category -> how many instance labels of it have been handed out."""
 
     # -- construction -------------------------------------------------------------------------
     @classmethod
@@ -125,7 +131,6 @@ class World:
                 center=np.array(f.center, dtype=float), size=np.array(f.size, dtype=float),
                 openable=f.openable, is_open=f.open,
             ))
-        world.assign_labels()
         return world
 
     def add(self, obj: WorldObject) -> WorldObject:
@@ -136,6 +141,7 @@ class World:
         self.semantic_id(obj.category)
         self.objects[obj.name] = obj
         self.version += 1
+        self.layout_version += 1
         return obj
 
     def semantic_id(self, category: str) -> int:
@@ -146,15 +152,36 @@ class World:
             self.class_names.append(category)
             return len(self.class_names) - 1
 
+    # -- instance labels ----------------------------------------------------------------------
+    # An object has no label until it is observed (or named by the task description): labels are
+    # handed out per category in that order, so a label never reveals an instance not yet seen.
+    def reserve_label(self, name: str) -> str:
+        """The object's label, giving it the next free one of its category first if it has none.
+
+        Floors get none (they are named by their room).
+        """
+        obj = self.objects[name]
+        if not obj.label and obj.kind != "floor":
+            used = self._labels_used.get(obj.category, 0)
+            obj.label = f"{obj.category} {_alpha(used)}"
+            self._labels_used[obj.category] = used + 1
+        return obj.label
+
+    def observe(self, names: Iterable[str]) -> None:
+        """Label the objects among ``names`` seen for the first time, in the order given."""
+        for name in names:
+            self.reserve_label(name)
+
+    def display_label(self, name: str) -> str:
+        """What the robot may call an object: its label once observed, else just its category."""
+        obj = self.objects[name]
+        return obj.label or obj.category
+
     def assign_labels(self) -> None:
-        """Give every object an alphabetical instance label per category ('fridge A', 'fridge B'), by name order."""
-        by_category: dict[str, list[WorldObject]] = {}
-        for obj in self.objects.values():
-            if obj.kind != "floor":
-                by_category.setdefault(obj.category, []).append(obj)
-        for category, objs in by_category.items():
-            for i, obj in enumerate(sorted(objs, key=lambda o: _natural_key(o.name))):
-                obj.label = f"{category} {_alpha(i)}"
+        """Label every object not labelled yet, per category in name order (tools and tests; an
+        episode labels objects as they are observed)."""
+        for obj in sorted(self.objects.values(), key=lambda o: _natural_key(o.name)):
+            self.reserve_label(obj.name)
 
     # -- queries ------------------------------------------------------------------------------
     def get(self, name: str) -> WorldObject:
@@ -229,6 +256,7 @@ class World:
             raise ValueError(f"{name} is not openable")
         obj.is_open = is_open
         self.version += 1
+        self.layout_version += 1
 
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
@@ -239,6 +267,19 @@ class World:
         if self.robot.held == name:
             self.robot.held = None
         self.version += 1
+        self.layout_version += 1
+
+    def place_if_room(self, name: str, parent: str, relation: Relation) -> bool:
+        """Like ``place``, but only where a free slot exists; False (nothing changed) when there is none."""
+        obj, support = self.objects[name], self.objects[parent]
+        slot = self.free_slot(obj, support, relation)
+        if slot is None:
+            return False
+        obj.parent, obj.relation, obj.room = parent, relation, support.room
+        self._move_subtree(obj, slot)
+        self.version += 1
+        self.layout_version += 1
+        return True
 
     def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
         """Rest item ``name`` on a room floor at a given position (no precondition checks)."""
@@ -248,6 +289,7 @@ class World:
         if self.robot.held == name:
             self.robot.held = None
         self.version += 1
+        self.layout_version += 1
 
     def pick(self, name: str) -> None:
         """Put item ``name`` in the robot's gripper, detached from its support (no precondition checks)."""
@@ -256,12 +298,15 @@ class World:
         self.robot.held = name
         self._carry()
         self.version += 1
+        self.layout_version += 1
 
     def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
         self.version += 1
+        if self.robot.held is not None:  # the held item moved along
+            self.layout_version += 1
 
     def _carry(self) -> None:
         """Move the held item (and what rests in / on it) to the gripper, ``CARRY_HEIGHT_M`` above the base."""
@@ -289,26 +334,35 @@ class World:
         return lo[:2] + margin, hi[:2] - margin, support.bottom + slab
 
     def _free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray:
-        """Centre of the first slot on the support, in reading order, not overlapping its other items.
-
-        Items larger than the support, or a full support, fall back to the support's centre: magic
-        placement, like the paper's, never fails for lack of room.
-        """
+        """Centre of the first free slot on the support (``free_slot``), else the support's centre:
+        magic placement, like the paper's, never fails for lack of room."""
+        slot = self.free_slot(obj, support, relation)
+        if slot is not None:
+            return slot
         lo, hi, z = self.support_surface(support, relation)
-        half = obj.size[:2] / 2 + SLOT_GAP_M / 2
-        others = [o for o in self.children(support.name, relation) if o.name != obj.name]
-        xs = np.arange(lo[0] + half[0], hi[0] - half[0] + 1e-9, 2 * half[0])
-        ys = np.arange(lo[1] + half[1], hi[1] - half[1] + 1e-9, 2 * half[1])
-        for y in ys:
-            for x in xs:
-                if not any(_overlap_xy((x, y), half, o) for o in others):
-                    return np.array([x, y, z + obj.size[2] / 2])
         cx, cy = (lo + hi) / 2
         return np.array([cx, cy, z + obj.size[2] / 2])
 
-
-def _overlap_xy(xy: tuple[float, float], half: np.ndarray, other: WorldObject) -> bool:
-    return bool(np.all(np.abs(np.asarray(xy) - other.center[:2]) < half + other.size[:2] / 2))
+    def free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray | None:
+        """Centre of the first slot on the support, in reading order, overlapping none of its other
+        items; None when the item is larger than the support or the support is full."""
+        lo, hi, z = self.support_surface(support, relation)
+        half = obj.size[:2] / 2 + SLOT_GAP_M / 2
+        xs = np.arange(lo[0] + half[0], hi[0] - half[0] + 1e-9, 2 * half[0])
+        ys = np.arange(lo[1] + half[1], hi[1] - half[1] + 1e-9, 2 * half[1])
+        if not len(xs) or not len(ys):
+            return None
+        others = [o for o in self.children(support.name, relation) if o.name != obj.name]
+        gx, gy = np.meshgrid(xs, ys)  # rows follow y: reading order is row by row
+        slots = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        if others:
+            centers = np.array([o.center[:2] for o in others])
+            reach = half + np.array([o.size[:2] / 2 for o in others])
+            overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
+            slots = slots[~overlap]
+        if not len(slots):
+            return None
+        return np.array([slots[0, 0], slots[0, 1], z + obj.size[2] / 2])
 
 
 def _alpha(i: int) -> str:

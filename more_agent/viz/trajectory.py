@@ -6,7 +6,7 @@ episode's ``map.png`` on top of ``more_agent.viz.plan.draw_plan``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -32,24 +32,29 @@ def draw_trajectory(ax: Axes, trajectory: Sequence[tuple[float, float]], *, colo
     ax.plot(xs[-1], ys[-1], "s", color=color, ms=7, zorder=11, label="end")
 
 
-def draw_items(ax: Axes, world: World) -> None:
-    """Items as small dots with their labels, so the map shows where things ended up."""
-    for obj in world.items():
-        if world.robot.held == obj.name:
-            continue
-        ax.plot(obj.center[0], obj.center[1], ".", color="black", ms=4, zorder=9)
-        ax.annotate(obj.label, (obj.center[0], obj.center[1]), fontsize=5, zorder=9, xytext=(2, 2), textcoords="offset points")
+def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) -> None:
+    """Items as small dots, with their labels (only for ``labelled`` names when given: a store holds
+    hundreds of items), so the map shows where things ended up."""
+    items = [o for o in world.items() if world.robot.held != o.name]
+    if not items:
+        return
+    ax.plot([o.center[0] for o in items], [o.center[1] for o in items], ".", color="black", ms=4, zorder=9)
+    for obj in items:
+        if labelled is None or obj.name in labelled:
+            ax.annotate(world.display_label(obj.name), (obj.center[0], obj.center[1]), fontsize=5, zorder=9,
+                        xytext=(2, 2), textcoords="offset points")
 
 
 def save_trajectory_map(
-    world: World, trajectory: Sequence[tuple[float, float]], path: Path, *, title: str = "", dpi: int = 120
+    world: World, trajectory: Sequence[tuple[float, float]], path: Path, *, title: str = "", dpi: int = 120,
+    labelled: Collection[str] | None = None,
 ) -> None:
     """Write the plan of ``world`` (doors and furniture as they are now), its items and the robot's path to ``path``."""
     fig, ax = plan_figure(world.scene)
     try:
         open_state = {o.name: o.is_open for o in world.objects.values() if o.openable}
         draw_plan(ax, world.scene, open_state=open_state)
-        draw_items(ax, world)
+        draw_items(ax, world, labelled)
         draw_trajectory(ax, trajectory)
         ax.set_title(title, fontsize=9)
         fig.savefig(path, dpi=dpi, bbox_inches="tight")

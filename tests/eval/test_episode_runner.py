@@ -32,6 +32,17 @@ def test_observed_objects_match_goal_condition_names_so_rtp_counts_them() -> Non
     assert rtp(record) == 1.0
 
 
+def test_record_says_how_hard_the_world_was() -> None:
+    record = run_episode(SPEC)
+    stats = record.world_stats
+    assert stats is not None and stats.task_objects >= 5 and stats.objects > stats.task_objects
+    assert stats.start_room and stats.task_rooms and stats.start_to_task_m is not None and stats.start_to_task_m >= 0
+    task_room = run_episode(SPEC.model_copy(update={"start": "task-room"})).world_stats
+    assert task_room is not None and task_room.start_room in task_room.task_rooms
+    store = run_episode(EpisodeSpec(task="bag_groceries", scene="grocery_store_asian", seed=0, planner="oracle"))
+    assert store.world_stats is not None and store.world_stats.objects >= 500 and store.world_stats.distractors >= 400
+
+
 NOTHING_HAPPENS = ActionResult(ok=False, reason=None, feedback="nothing happens")
 """The result of waiting in place: a failing no-op."""
 

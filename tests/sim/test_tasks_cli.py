@@ -33,7 +33,14 @@ def test_show_unknown_task_exits_2_with_closest_names() -> None:
     assert "putting_shopping_away" in result.output and "Traceback" not in result.output
 
 
-def test_show_in_unsuitable_scene_exits_2_naming_the_literal() -> None:
+def test_show_in_unsuitable_scene_exits_2_naming_the_candidates() -> None:
     result = runner.invoke(app, ["tasks", "show", "putting_shopping_away", "--scene", "gates_bedroom"])
     assert result.exit_code == 2
-    assert "inroom" in result.output and "Traceback" not in result.output
+    assert "does not suit" in result.output and "Beechwood_0_int" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_show_lists_the_scenes_episodes_draw_from() -> None:
+    result = runner.invoke(app, ["tasks", "show", "putting_shopping_away", "--seed", "1"])
+    assert result.exit_code == 0, result.output
+    assert "episode scenes" in result.output and "drawn for seed 1:" in result.output

@@ -1,0 +1,117 @@
+"""Where the robot starts, and how far that is from the task: the paper places the agent at random.
+
+``random_start`` draws a pose uniformly over the reachable free space of the whole scene: the cells
+of the ground-truth navigation grid (every door counted open, as the robot can open them) that lie
+in a connected component holding a base pose from which the magic actions reach some task object,
+indoors or outdoors; the position is uniform within the drawn cell and the heading uniform.
+``start_facts`` measures the start against the task: the rooms holding task objects, and the
+shortest path on that grid from the start to the nearest such pose.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from more_agent.errors import UserError
+from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
+from more_agent.sim.navgrid import NavGrid, nav_grid, shortest_path
+from more_agent.sim.world import World
+
+MIN_ROOM_FREE_M2 = 1.0
+"""A room counts for the per-room start draw when it has at least this much reachable free floor."""
+
+START_MODES = ("random", "random-area", "task-room")
+"""``random`` (default): a reachable room drawn uniformly, then a uniform pose in it; ``random-area``:
+a pose uniform over all reachable free space, so large rooms (stores, gardens) take most starts;
+``task-room``: a free spot in the room of the task's ``(ontop agent floor)`` literal."""
+
+
+def check_start(start: str) -> None:
+    """Raise a UserError naming the valid values when ``start`` is not one of ``START_MODES``."""
+    if start not in START_MODES:
+        raise UserError(f"unknown start {start!r}; use --start with one of: {', '.join(START_MODES)}")
+
+
+@dataclass(frozen=True)
+class StartFacts:
+    """How far from the task the robot starts (the ``WorldStats`` of an episode record, less the counts)."""
+
+    start_room: str
+    task_rooms: list[str] = field(default_factory=list)
+    start_to_task_m: float | None = None
+    """Path length from the start to within reach of the nearest task object; None when none is reachable."""
+
+
+def _cell_centres(grid: NavGrid) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) of every cell centre, each of the grid's shape."""
+    rows, cols = np.indices(grid.shape)
+    return grid.origin[0] + (cols + 0.5) * grid.resolution_m, grid.origin[1] + (rows + 0.5) * grid.resolution_m
+
+
+def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[tuple[int, int]]:
+    """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
+    cells = []
+    for t in targets:
+        x0, y0, x1, y1 = reach_box(world, t)
+        for poses in candidate_poses(world, t):
+            cells += [grid.to_cell(x, y) for x, y in poses
+                      if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)]
+    return cells
+
+
+def random_start(
+    world: World, targets: list[str], rng: np.random.Generator, *, by_room: bool = False,
+) -> tuple[float, float, float] | None:
+    """A uniformly drawn (x, y, yaw) on the free space connected to a pose that reaches a task object
+    (anywhere free when there is no target); None if there is none.
+
+    With ``by_room`` the room is drawn first, uniformly among the rooms with at least
+    ``MIN_ROOM_FREE_M2`` of such free space, then the position uniformly within it.
+    """
+    grid = nav_grid(world, all_doors_open=True)
+    components, _ = ndimage.label(grid.free, structure=np.ones((3, 3)))
+    goals = approach_cells(world, grid, targets)
+    keep = np.unique([components[c] for c in goals]) if targets else np.unique(components)
+    free = np.isin(components, keep[keep > 0])
+    if by_room:
+        min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
+        x, y = _cell_centres(grid)
+        in_room = [free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
+                   for r in world.scene.rooms]
+        rooms = [m for m in in_room if m.sum() >= min_cells]
+        if rooms:
+            free = rooms[rng.integers(len(rooms))]
+    cells = np.flatnonzero(free)
+    if len(cells) == 0:
+        return None
+    r, c = np.unravel_index(cells[rng.integers(len(cells))], grid.shape)
+    x, y = grid.to_xy(int(r), int(c))
+    jitter = rng.uniform(-0.5, 0.5, size=2) * grid.resolution_m
+    return float(x + jitter[0]), float(y + jitter[1]), float(rng.uniform(-np.pi, np.pi))
+
+
+def start_to_task_m(world: World, targets: list[str]) -> float | None:
+    """Path length (doors open) from the robot to the nearest pose from which a task object is within reach."""
+    grid = nav_grid(world, all_doors_open=True)
+    goals = [grid.to_xy(*c) for c in approach_cells(world, grid, targets)]
+    path = shortest_path(grid, (world.robot.x, world.robot.y), goals)
+    return round(path.length_m, 3) if path.found else None
+
+
+def task_rooms(world: World, targets: Iterable[str]) -> list[str]:
+    """The rooms holding task objects now (where an item rests, a piece of furniture stands), sorted."""
+    return sorted({room for t in targets if (room := world.get(t).room) is not None})
+
+
+def start_facts(world: World, targets: list[str]) -> StartFacts:
+    """The start room, task rooms and start-to-task path length of the world as it is now."""
+    return StartFacts(
+        start_room=world.room_at(world.robot.x, world.robot.y) or "",
+        task_rooms=task_rooms(world, targets),
+        start_to_task_m=start_to_task_m(world, targets),
+    )
