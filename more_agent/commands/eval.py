@@ -68,8 +68,11 @@ def eval_(
     check_start(start)
     if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
+        from more_agent.sim.scenes import get_scene
 
         check_task_names(names)
+        if scene is not None:
+            get_scene(scene)  # an unknown scene fails with the closest names
         for name in names if scene is not None else ():
             check_scene_suits(name, scene)
         make_planner(planner, llm)  # an unknown planner or a missing LLM fails here, before any episode

@@ -190,7 +190,8 @@ def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     rebuilt from (task, scene, seed, start) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
-    _write_map(record, instantiate(spec.task, spec.scene, spec.seed, start=spec.start).world, out_dir)
+    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start)
+    _write_map(record, instance.world, out_dir, set(instance.scope.values()))
 
 
 def _run_steps(
@@ -218,7 +219,7 @@ def _run_steps(
         record.low_level_steps += result.low_level_steps
         _extend_path(record.trajectory, result.path)
         if timeline is not None:
-            timeline.append(record, status, [world.get(a).label if a in world.objects else a for a in action.arguments])
+            timeline.append(record, status, [world.display_label(a) if a in world.objects else a for a in action.arguments])
         if action.is_done:
             record.done_called = True
             if not status.all_met and action.gave_up:
