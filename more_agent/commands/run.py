@@ -17,7 +17,8 @@ from more_agent.commands._common import console, user_errors_exit_2
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 
 NO_LLM_MESSAGE = (
-    "No LLM configured: running the privileged oracle planner. To plan with MORE, pass "
+    "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
+    "and subpolicies as MORE; --planner oracle is the privileged upper bound). To plan with MORE, pass "
     "--llm openai:MODEL (key in OPENAI_API_KEY, any OpenAI-compatible server in OPENAI_BASE_URL) or "
     "--llm llamacpp:PATH.gguf, or set MORE_AGENT_LLM / a config file (see docs/llm.md)."
 )
@@ -59,7 +60,7 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
 @user_errors_exit_2
 def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
-    planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
+    planner: Annotated[str | None, typer.Option(help="Planner name (default: more with an LLM, grounded without).")] = None,
     scene: Annotated[str | None, typer.Option(help="Scene name or scene .json file (default: the task's first suitable scene).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of scene generation and task instantiation.")] = 0,
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import logging
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,7 +57,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
-from more_agent.planners.policies.skills import pick_target
+from more_agent.planners.policies.skills import pick_target, without_visited_frontiers
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.viz.graph_plot import save_step_graph
@@ -183,7 +182,7 @@ class LLMPlanner:
     def observe(self) -> None:
         """Build the scene graph, label new regions, put it into words."""
         body = self._body()
-        graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
+        graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         labels = self._classify_rooms(graph)
         if labels:
             body.builder.set_room_labels(labels)
@@ -339,17 +338,6 @@ class LLMPlanner:
         if self.view is None:
             raise RuntimeError("observe() must be called before decide() / execute()")
         return self.view
-
-
-def _without_visited_frontiers(graph: SceneGraph, visited: Sequence[tuple[float, float]], radius_m: float) -> SceneGraph:
-    """The graph without frontiers near ones already explored, so the text and explore() agree."""
-    if not visited:
-        return graph
-    regions = {
-        rid: r.model_copy(update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]})
-        for rid, r in graph.regions.items()
-    }
-    return graph.model_copy(update={"regions": regions})
 
 
 def make_more(llm: str | None) -> LLMPlanner:
