@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
+from more_agent.eval.failure import classify_failure
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.sim.navgrid import XY
@@ -127,6 +128,7 @@ def run_episode(
         record.traceback = traceback.format_exc()
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
+    record.failure = classify_failure(record, world)
     if out_dir is not None:
         t = time.perf_counter()
         _write_map(record, world, Path(out_dir))

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from more_agent.eval.record import LLMUsage
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.language import room_names
-from more_agent.planners.oracle import order_literals
+from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
 from more_agent.planners.policies.skills import place_on_floor, without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, likely_room_type
@@ -48,6 +48,9 @@ FLOOR = "floor"
 
 MAX_FAILURES = 2
 """An action is not tried again after failing this many times the same way."""
+
+MAX_REACH_FAILURES = 3
+"""An object is given up after this many failed approaches (the robot explores in between)."""
 
 Relation = tuple[str, str]
 """(predicate 'inside' / 'ontop', label of the container / support, or 'floor <room>')."""
@@ -79,8 +82,10 @@ class GroundedPlanner:
         """Read the goal, start the robot with a full turn in place (paper S.3)."""
         self.goal: TaskGoal = task_goal(context.instance, context.goals)
         self.body = Embodiment.for_episode(context, config=self.config)
-        self.option = 0
-        self.literals: list[Literal] = order_literals(list(self.goal.options[0]))
+        option = self.goal.options[0]
+        self.skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
+        """Literals no subpolicy can achieve (named when the planner calls done)."""
+        self.literals: list[Literal] = order_literals([lit for lit in option if lit not in self.skipped])
         self.bound: dict[str, str] = {}
         self.seen: dict[str, ObjectNode] = {}
         """Label -> the object as last observed (objects of rooms now out of reach included)."""
@@ -88,6 +93,8 @@ class GroundedPlanner:
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
         self.dropped: set[str] = set()
+        self.out_of_reach: dict[str, int] = {}
+        """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
         self.failures: Counter[tuple[str, tuple[str, ...], str]] = Counter()
         self.room_types: dict[str, str] = {}
         self.graph: SceneGraph | None = None
@@ -207,7 +214,9 @@ class GroundedPlanner:
             return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up: {why}"))
         pending = [(lit, h) for lit, h in status if h is not True]
         if not pending:
-            return _Step(HighLevelAction(DONE, note="every goal literal holds in the scene graph"))
+            why = "; ".join(lit.text for lit in self.skipped)
+            return _Step(HighLevelAction(DONE, note="every goal literal holds in the scene graph",
+                                         gave_up=f"goal literals no subpolicy achieves: {why}" if why else ""))
         held = self._graph().held_object
         if held is not None:
             step = self._place_held(held.label, [lit for lit, h in pending if h is False])
@@ -218,7 +227,8 @@ class GroundedPlanner:
                 step = self._act_for(lit, held.label if held is not None else None)
                 if step is not None:
                     return step
-        missing = next(lit for lit, h in pending if h is None)
+        # Nothing to act on now: find what is unseen, else what is out of reach.
+        missing = next((lit for lit, h in pending if h is None), pending[0][0])
         return self._search(missing, held.label if held is not None else None)
 
     def _place_held(self, held: str, unmet: list[Literal]) -> _Step | None:
@@ -233,13 +243,13 @@ class GroundedPlanner:
                     return self._floor_step(region, f"for {lit.text}")
                 continue
             b = self.bound[target]
-            if b in self._graph().objects and not self._must_open(b, lit.predicate):
+            if b in self._reachable() and not self._must_open(b, lit.predicate):
                 return self._object_step(f"go_to_and_place_{lit.predicate}", b, f"for {lit.text}")
         return None
 
     def _act_for(self, lit: Literal, held: str | None) -> _Step | None:
         """The next action towards an unmet literal whose objects are all known, or None if it cannot act now."""
-        objects = self._graph().objects
+        objects = self._reachable()
         note = f"for {lit.text}"
         if lit.predicate == "open":
             label = self.bound[lit.args[0]]
@@ -267,6 +277,11 @@ class GroundedPlanner:
         if held == a:  # negated literal: take it away from where it must not be
             return self._put_down(held)
         return self._object_step("go_to_and_grasp", a, note)
+
+    def _reachable(self) -> set[str]:
+        """Labels of objects in the current graph, less those whose approach failed since the robot last moved."""
+        moved = len(self.body.trajectory)
+        return {o for o in self._graph().objects if self.out_of_reach.get(o, -1) != moved}
 
     def _must_open(self, label: str, predicate: str) -> bool:
         obj = self.seen[label]
@@ -358,9 +373,16 @@ class GroundedPlanner:
 
     def _failed(self, action: HighLevelAction, step: _Step, result: ActionResult) -> None:
         """Count a failure; an action failing twice the same way drops its target from the bindings."""
-        key = (action.name, action.arguments, result.feedback)
+        if step.target is None:
+            return
+        if result.reason is FailureReason.NOT_REACHABLE:
+            self.out_of_reach[step.target] = len(self.body.trajectory)
+            key = (action.name, action.arguments, "not reachable")
+            limit = MAX_REACH_FAILURES
+        else:
+            key, limit = (action.name, action.arguments, result.feedback), MAX_FAILURES
         self.failures[key] += 1
-        if self.failures[key] < MAX_FAILURES or step.target is None:
+        if self.failures[key] < limit:
             return
         self.dropped.add(step.target)
         for scope, label in list(self.bound.items()):

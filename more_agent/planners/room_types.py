@@ -36,8 +36,8 @@ def category_likelihood(category: str, room_type: str) -> float:
     counts = room_type_counts().get(room_type)
     if counts is None:
         return 0.0
-    total = sum(counts.values())
-    return (counts.get(category, 0) + SMOOTHING) / (total + SMOOTHING * (len(counts) + 1))
+    vocabulary = len(set().union(*room_type_counts().values())) + 1
+    return (counts.get(category, 0) + SMOOTHING) / (sum(counts.values()) + SMOOTHING * vocabulary)
 
 
 def likely_room_type(categories: Iterable[str]) -> str | None:

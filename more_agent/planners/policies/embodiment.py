@@ -43,6 +43,11 @@ class PolicyConfig(BaseModel):
     visited_frontier_m: float = Field(
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
+    blind_radius_m: float = Field(
+        default=0.55, ge=0, description="Unknown cells this close to where the robot has been count as free on "
+        "its map: the camera (1.2 m high, pitched 20 degrees, 90 degree field of view) never sees the floor within "
+        "0.56 m of the robot."
+    )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
 

@@ -1,7 +1,9 @@
 """Paths on the agent's own map: the BEV occupancy of the scene graph, inflated, as a navigation grid.
 
 Only cells the robot has seen free count as traversable, kept ``plan_inflation_m`` away from mapped
-obstacles (unknown space is not traversable but does not inflate). Shortest paths use the same
+obstacles (unknown space is not traversable but does not inflate), plus the unknown cells close to
+where the robot has stood: the pitched camera never sees the floor right around the robot, and
+without them the robot's own spot is a hole that cuts it off from the map it has seen. Shortest paths use the same
 8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.navgrid.shortest_path`,
 an optimal search like A* with an admissible heuristic), here on what the agent knows.
 """
@@ -19,11 +21,23 @@ from more_agent.scene_graph import OccupancyMap, SceneGraph
 from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
 
 
-def agent_nav_grid(occupancy: OccupancyMap, *, inflation_m: float) -> NavGrid:
-    """The traversable raster of the agent's map: seen-free cells at least ``inflation_m`` from obstacles."""
+def agent_nav_grid(
+    occupancy: OccupancyMap, *, inflation_m: float, stood_xy: Sequence[XY] = (), blind_radius_m: float = 0.0,
+) -> NavGrid:
+    """The traversable raster of the agent's map: seen-free cells, and unknown cells within
+    ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles."""
     grid = np.asarray(occupancy.grid).T  # model is [ix, iy]; NavGrid is [row = y, col = x]
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
-    free = (grid == FREE) & (clearance > inflation_m)
+    known_free = grid == FREE
+    if len(stood_xy) and blind_radius_m > 0:
+        res, (x0, y0) = occupancy.resolution_m, occupancy.origin_xy
+        cells = np.floor((np.asarray(stood_xy, dtype=float) - (x0, y0)) / res).astype(int)
+        inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < grid.shape[1]) & (cells[:, 1] < grid.shape[0])
+        seeds = np.ones(grid.shape, dtype=bool)
+        seeds[cells[inside, 1], cells[inside, 0]] = False
+        near = ndimage.distance_transform_edt(seeds) * res <= blind_radius_m
+        known_free |= near & (grid != OCCUPIED)
+    free = known_free & (clearance > inflation_m)
     return NavGrid(
         free=free, origin=tuple(occupancy.origin_xy), resolution_m=occupancy.resolution_m,
         closed_doors=frozenset(), door_cells={},
