@@ -4,14 +4,15 @@ Every low-level action goes through :mod:`more_agent.sim.motion` (7.5 cm forward
 most 35 degrees) and is counted; frames are rendered and fused into the
 :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
 moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
-Perception is ground truth as in the paper (S.2): instance attributes are read from the world.
+Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
+rests (inside / on top of what) are read from the world for the instances in view.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -93,29 +94,44 @@ class Embodiment:
         """Robot base position."""
         return (float(self.world.robot.x), float(self.world.robot.y))
 
-    def sense(self) -> None:
+    def sense(self, acted_on: Sequence[str] = ()) -> None:
         """Render a frame from the current pose and fuse it into the scene-graph builder.
 
-        The robot knows what it let go of: an item released since the last frame is reported as no
-        longer held even when no camera sees it (the builder only updates instances it is told about).
+        The robot knows what it did: an item released since the last frame is reported as no longer
+        held, resting where it was put, even when no camera sees it (the builder keeps it at that box
+        until a frame shows it), and the objects in ``acted_on`` (world names: what it just opened or
+        closed) are reported with their new state even when out of view.
         """
         frame = self.renderer.render(self.world)
         if self.on_frame is not None:
             self.on_frame(frame)
         table = instance_table(self.world, frame.instance)
         infos = {
-            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"])
+            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"],
+                            rests=self._rests(d["name"]))
             for i, d in table.items()
         }
         released = self._held if self._held is not None and self._held != self.world.robot.held else None
-        if released is not None:
-            obj = self.world.get(released)
+        for name in [*acted_on, *([released] if released is not None else [])]:
+            obj = self.world.get(name)
             infos.setdefault(obj.instance_id, InstanceInfo(
-                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None, held=False,
+                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None,
+                held=self.world.robot.held == name, rests=self._rests(name),
             ))
+        if released is not None:
+            self.builder.remember(self.world.get(released).instance_id, *self.world.get(released).box())
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
+
+    def _rests(self, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
+        """How a seen object rests, as perception reports it: the world's support link (what the last
+        placement did), the support named by its label (None for a floor); None while held."""
+        obj = self.world.get(name)
+        if obj.parent is None or obj.relation is None:
+            return None if self.world.robot.held == name else ("ontop", None)
+        parent = self.world.get(obj.parent)
+        return obj.relation, parent.label if parent.kind != "floor" else None
 
     def build(self) -> SceneGraph:
         """The scene graph of everything sensed so far, from the robot's position."""

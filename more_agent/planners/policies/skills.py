@@ -105,7 +105,7 @@ def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode
     result = actions.go_to_and(world, verb, obj.name)
     body.record_jump(result.path, result.low_level_steps)
     if result.ok:
-        body.sense()  # what opening / placing revealed
+        body.sense(acted_on=(obj.name,))  # what opening / placing revealed; the new state even out of view
     return ActionResult(
         ok=result.ok, reason=result.reason, feedback=result.feedback,
         low_level_steps=body.low_level_steps - start, blocking=result.blocking,
