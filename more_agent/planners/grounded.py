@@ -223,6 +223,8 @@ class GroundedPlanner:
             if step is not None:
                 return step
         for lit, h in pending:
+            if lit.predicate == "open" and lit.negated and len(pending) > 1:
+                continue  # close last: what is inside may still be needed
             if h is False:
                 step = self._act_for(lit, held.label if held is not None else None)
                 if step is not None:
@@ -276,7 +278,17 @@ class GroundedPlanner:
             return self._put_down(held)
         if held == a:  # negated literal: take it away from where it must not be
             return self._put_down(held)
+        hider = self._closed_container_of(a)
+        if hider is not None:
+            return self._object_step("go_to_and_open", hider, note) if hider in objects else None
         return self._object_step("go_to_and_grasp", a, note)
+
+    def _closed_container_of(self, label: str) -> str | None:
+        """The closed container ``label`` was last seen (or put) inside, if any."""
+        rel = self.relation.get(label)
+        if rel is None or rel[0] != "inside" or rel[1] not in self.seen:
+            return None
+        return rel[1] if self.seen[rel[1]].open is False else None
 
     def _reachable(self) -> set[str]:
         """Labels of objects in the current graph, less those whose approach failed since the robot last moved."""

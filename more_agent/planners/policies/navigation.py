@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy import ndimage
@@ -54,8 +55,20 @@ def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | No
     return out
 
 
+def reachable_part(grid: NavGrid, start: XY) -> NavGrid:
+    """The grid reduced to the 8-connected free component the robot (snapped) stands in, so that goals
+    snap to cells it can drive to, never to an island of free space cut off by unknown cells."""
+    cell = grid.snap(*start)
+    if cell is None:
+        return grid
+    components, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
+    return replace(grid, free=components == components[cell])
+
+
 def path_to_nearest(grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: float) -> tuple[PathResult, int | None]:
-    """Shortest path from ``start`` to the nearest reachable goal (goals snapped first) and that goal's index."""
+    """Shortest path from ``start`` to the nearest reachable goal (goals snapped first, to the robot's
+    free component) and that goal's index."""
+    grid = reachable_part(grid, start)
     snapped = snap_goals(grid, goals, snap_m)
     usable = [i for i, g in enumerate(snapped) if g is not None]
     if not usable:
