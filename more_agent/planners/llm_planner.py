@@ -55,9 +55,9 @@ from more_agent.llm import (
 from more_agent.llm.completion import Completion
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
-from more_agent.planners.language import LanguageOptions, SceneView, scene_view
+from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
-from more_agent.planners.policies.skills import pick_target, without_visited_frontiers
+from more_agent.planners.policies.skills import pick_target, place_on_floor, without_visited_frontiers
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.viz.graph_plot import save_step_graph
@@ -309,6 +309,8 @@ class LLMPlanner:
         room = action.arguments[0]
         if action.name == "explore":
             return explore(body, graph, view.room(room).region_id, room)
+        if action.arguments[1] == FLOOR and not view.resolve(room, FLOOR):
+            return _floor_action(body, graph, action, view.room(room).region_id, room)
         target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
         if target is None:
             return ActionResult(ok=False, reason=FailureReason.UNKNOWN_OBJECT,
@@ -338,6 +340,13 @@ class LLMPlanner:
         if self.view is None:
             raise RuntimeError("observe() must be called before decide() / execute()")
         return self.view
+
+
+def _floor_action(body: Embodiment, graph: SceneGraph, action: HighLevelAction, region_id: str, room: str) -> ActionResult:
+    """A skill on a room's floor: only placing on it is possible."""
+    if action.name == "go_to_and_place_ontop":
+        return place_on_floor(body, graph, region_id, room)
+    return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"cannot {action.name} the floor of {room}")
 
 
 def make_more(llm: str | None) -> LLMPlanner:

@@ -20,7 +20,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
 from more_agent.sim.motion import full_turn_angles, move_forward, turn
-from more_agent.sim.navgrid import XY
+from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
 
@@ -72,6 +72,8 @@ class Embodiment:
         self.observed: set[str] = set()
         """World object names seen so far (for the rTP metric)."""
         self.visited_frontiers: list[XY] = []
+        self.bumps: list[XY] = []
+        """Where blocked moves met something (just ahead of the base): obstacles on the robot's map."""
         self.on_frame: Callable[[Frame], None] | None = None
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
@@ -170,6 +172,9 @@ class Embodiment:
                 result = move_forward(self.world, min(FORWARD_STEP_M, remaining))
                 self.low_level_steps += 1
                 if not result.ok:
+                    reach = FORWARD_STEP_M + DEFAULT_NAV.robot_radius_m
+                    yaw = self.world.robot.yaw
+                    self.bumps.append((self.xy[0] + reach * math.cos(yaw), self.xy[1] + reach * math.sin(yaw)))
                     self.sense()
                     return False
                 remaining -= result.applied

@@ -24,25 +24,36 @@ from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
 
 def agent_nav_grid(
     occupancy: OccupancyMap, *, inflation_m: float, stood_xy: Sequence[XY] = (), blind_radius_m: float = 0.0,
+    bumped_xy: Sequence[XY] = (),
 ) -> NavGrid:
     """The traversable raster of the agent's map: seen-free cells, and unknown cells within
-    ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles."""
-    grid = np.asarray(occupancy.grid).T  # model is [ix, iy]; NavGrid is [row = y, col = x]
+    ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
+    ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed)."""
+    grid = np.asarray(occupancy.grid).T.copy()  # model is [ix, iy]; NavGrid is [row = y, col = x]
+    bumps = _cells(occupancy, bumped_xy, grid.shape)
+    grid[bumps[:, 1], bumps[:, 0]] = OCCUPIED
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
     known_free = grid == FREE
     if len(stood_xy) and blind_radius_m > 0:
-        res, (x0, y0) = occupancy.resolution_m, occupancy.origin_xy
-        cells = np.floor((np.asarray(stood_xy, dtype=float) - (x0, y0)) / res).astype(int)
-        inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < grid.shape[1]) & (cells[:, 1] < grid.shape[0])
+        cells = _cells(occupancy, stood_xy, grid.shape)
         seeds = np.ones(grid.shape, dtype=bool)
-        seeds[cells[inside, 1], cells[inside, 0]] = False
-        near = ndimage.distance_transform_edt(seeds) * res <= blind_radius_m
+        seeds[cells[:, 1], cells[:, 0]] = False
+        near = ndimage.distance_transform_edt(seeds) * occupancy.resolution_m <= blind_radius_m
         known_free |= near & (grid != OCCUPIED)
     free = known_free & (clearance > inflation_m)
     return NavGrid(
         free=free, origin=tuple(occupancy.origin_xy), resolution_m=occupancy.resolution_m,
         closed_doors=frozenset(), door_cells={},
     )
+
+
+def _cells(occupancy: OccupancyMap, points: Sequence[XY], shape: tuple[int, ...]) -> np.ndarray:
+    """(n, 2) integer (ix, iy) cells of the points that lie on the grid of ``shape`` (rows = iy)."""
+    if not len(points):
+        return np.zeros((0, 2), dtype=int)
+    cells = np.floor((np.asarray(points, dtype=float) - occupancy.origin_xy) / occupancy.resolution_m).astype(int)
+    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < shape[1]) & (cells[:, 1] < shape[0])
+    return cells[inside]
 
 
 def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | None]:

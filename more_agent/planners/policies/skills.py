@@ -46,7 +46,7 @@ def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY]) -> tuple[bo
         if occupancy is None:
             return False, None, "no map yet"
         grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
-                              blind_radius_m=cfg.blind_radius_m)
+                              blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps)
         path, index = path_to_nearest(grid, body.xy, goals, snap_m=cfg.goal_snap_m)
         if index is None:
             return False, None, "no path on the map"
