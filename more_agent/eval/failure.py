@@ -15,7 +15,7 @@ from more_agent.eval.record import ActionRecord, EpisodeRecord, Failure, Failure
 from more_agent.sim.world import World
 
 CAUSE_ORDER: tuple[FailureCause, ...] = (
-    "llm_error", "other", "done_not_called", "never_observed", "invalid_llm_answers", "wrong_instance",
+    "llm_error", "other", "done_not_called", "wrong_instance", "never_observed", "invalid_llm_answers",
     "unreachable", "subpolicy_failure", "done_early", "step_limit",
 )
 """Causes in the order they are tested; 'other' here means the episode raised (its traceback is kept)."""
@@ -50,15 +50,15 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     unmet = [c for c in record.goal_conditions if not c.satisfied]
     needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     labels = {o: world.get(o).label or o for o in needed}
+    wrong = _wrong_instances(record.actions, needed, world)
+    if wrong:
+        return Failure(cause="wrong_instance", detail=wrong)
     unseen = [o for o in needed if o not in set(record.observed_objects)]
     if unseen:
         return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
     invalid = sum(a.name == INVALID_ACTION for a in record.actions)
     if record.actions and invalid / len(record.actions) >= INVALID_SHARE:
         return Failure(cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers")
-    wrong = _wrong_instances(record.actions, needed, world)
-    if wrong:
-        return Failure(cause="wrong_instance", detail=wrong)
     refs = {ref for o in needed for ref in (o, labels[o])}  # the oracle names world objects, the others labels
     on_needed = [a for a in record.actions if not a.ok and refs & set(a.arguments)]
     reach = [a for a in on_needed if is_reach_failure(a)]

@@ -16,9 +16,11 @@ Every step (MPC style) it rebuilds the scene graph and:
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place, put down what the hand holds but does
    not need;
-4. when a needed object is unseen: opens the closed containers of the robot's room, explores the
-   room most likely to hold what is missing (BEHAVIOR-1K room inventories), then opens other
-   containers, then closed doors; it gives up with ``done`` when nothing is left to try.
+4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
+   at most while there is a room to explore), explores the
+   room most likely to hold what is missing (BEHAVIOR-1K room inventories; rooms explored three
+   times yield to the others; then the room explored least often, then the nearest), then opens other containers, then closed doors; it gives up with
+   ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
@@ -48,6 +50,12 @@ FLOOR = "floor"
 
 MAX_FAILURES = 2
 """An action is not tried again after failing this many times the same way."""
+
+OPENS_BEFORE_EXPLORING = 3
+"""Containers opened to look inside, one after the other, before the search explores again."""
+
+EXPLORES_BEFORE_MOVING_ON = 3
+"""A room explored this often yields to rooms explored less, however likely it is to hold what is missing."""
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
@@ -96,6 +104,9 @@ class GroundedPlanner:
         self.out_of_reach: dict[str, int] = {}
         """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
         self.failures: Counter[tuple[str, tuple[str, ...], str]] = Counter()
+        self.opened_in_a_row = 0
+        self.explored: Counter[str] = Counter()
+        """Region id -> explore() calls so far: rooms are explored breadth first, not one frontier after another."""
         self.room_types: dict[str, str] = {}
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
@@ -132,6 +143,8 @@ class GroundedPlanner:
     def decide(self) -> HighLevelAction:
         """``done`` when every goal literal holds as far as the robot knows, else the next action."""
         self._step = self._decide()
+        looking = self._step.action.name == "go_to_and_open" and self._step.action.note.startswith("looking for")
+        self.opened_in_a_row = self.opened_in_a_row + 1 if looking else 0
         return self._step.action
 
     def execute(self, action: HighLevelAction) -> ActionResult:
@@ -311,9 +324,9 @@ class GroundedPlanner:
              if o.open is False and o.category != "door" and o.label not in self.looked_into and o.label not in self.dropped),
             key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
         )
-        if closed and closed[0].region_id == here:
-            return self._open_to_look(closed[0].label, held, note)
         region = self._room_to_explore(missing)
+        if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
+            return self._open_to_look(closed[0].label, held, note)
         if region is not None:
             return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region)
         if closed:
@@ -335,10 +348,11 @@ class GroundedPlanner:
         graph = self._graph()
         cats = [c for s in missing for c in self.goal.categories.get(s, ())]
 
-        def score(rid: str) -> tuple[float, float, str]:
+        def score(rid: str) -> tuple[bool, float, int, float, str]:
             kind = self.room_types.get(rid)
             like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
-            return -like, math.dist(graph.regions[rid].centroid, self.body.xy), rid
+            return (self.explored[rid] >= EXPLORES_BEFORE_MOVING_ON, -like, self.explored[rid],
+                    math.dist(graph.regions[rid].centroid, self.body.xy), rid)
 
         open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
         return min(open_regions, key=score) if open_regions else None
@@ -365,6 +379,7 @@ class GroundedPlanner:
         if action.name == "explore":
             assert step.region is not None
             result = explore(body, graph, step.region, action.arguments[0])
+            self.explored[step.region] += 1
         elif step.target is None:
             held = graph.held_object
             result = place_on_floor(body, graph, step.region, action.arguments[0])
