@@ -111,7 +111,6 @@ class GroundedPlanner:
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
         self._step: _Step | None = None
-        self._reported_steps, self._reported_path = 0, 1
         self.body.sense()
         self.body.look_around()
 
@@ -149,13 +148,7 @@ class GroundedPlanner:
 
     def execute(self, action: HighLevelAction) -> ActionResult:
         """Run the decided step's subpolicy; the result counts the low-level steps and path since the last one."""
-        result = self._run(action)
-        body = self.body
-        steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
-        path = body.trajectory[self._reported_path - 1:] if len(body.trajectory) > self._reported_path else []
-        self._reported_path = len(body.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
-                            path=path, blocking=result.blocking)
+        return self.body.since_last_report(self._run(action))
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""

@@ -161,8 +161,6 @@ class LLMPlanner:
         self.graph: SceneGraph | None = None
         self.view: SceneView | None = None
         self.trace: StepTrace | None = None
-        self._reported_steps = 0
-        self._reported_path = 0
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
@@ -175,7 +173,6 @@ class LLMPlanner:
         self.task = context.instance.description
         self.history, self.feedback = [], ""
         self.usage, self.llm_seconds = UsageMeter(), 0.0
-        self._reported_steps, self._reported_path = 0, 1
         self.body.sense()
         self.body.look_around()
 
@@ -226,12 +223,7 @@ class LLMPlanner:
         if self.out_dir is not None:
             self._write_step(self.out_dir, self.history[-1])
         self.feedback = f"{action.name}: {'success' if result.ok else 'failure'}; {result.feedback}"
-        body = self._body()
-        steps, self._reported_steps = body.low_level_steps - self._reported_steps, body.low_level_steps
-        path = body.trajectory[self._reported_path - 1:] if len(body.trajectory) > self._reported_path else []
-        self._reported_path = len(body.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
-                            path=path, blocking=result.blocking)
+        return self._body().since_last_report(result)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""

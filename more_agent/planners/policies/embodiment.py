@@ -18,7 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
-from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
+from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult
 from more_agent.sim.motion import full_turn_angles, move_forward, turn
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
@@ -72,6 +72,7 @@ class Embodiment:
         self.observed: set[str] = set()
         """World object names seen so far (for the rTP metric)."""
         self.visited_frontiers: list[XY] = []
+        self._reported_steps, self._reported_path = 0, 1
         self.bumps: list[XY] = []
         """Where blocked moves met something (just ahead of the base): obstacles on the robot's map."""
         self.on_frame: Callable[[Frame], None] | None = None
@@ -125,6 +126,15 @@ class Embodiment:
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
+
+    def since_last_report(self, result: ActionResult) -> ActionResult:
+        """``result`` with the low-level steps and path the robot made since the previous call (the first
+        call's include the initial full turn): what one high-level step reports to the episode loop."""
+        steps, self._reported_steps = self.low_level_steps - self._reported_steps, self.low_level_steps
+        path = self.trajectory[self._reported_path - 1:] if len(self.trajectory) > self._reported_path else []
+        self._reported_path = len(self.trajectory)
+        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
+                            path=path, blocking=result.blocking)
 
     def _rests(self, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
         """How a seen object rests, as perception reports it: the world's support link (what the last
