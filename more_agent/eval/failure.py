@@ -50,7 +50,8 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     unmet = [c for c in record.goal_conditions if not c.satisfied]
     needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     labels = {o: world.get(o).label or o for o in needed}
-    wrong = _wrong_instances(record.actions, needed, world)
+    goal_objects = {o for c in record.goal_conditions for o in c.objects}
+    wrong = _wrong_instances(record.actions, needed, goal_objects, world)
     if wrong:
         return Failure(cause="wrong_instance", detail=wrong)
     unseen = [o for o in needed if o not in set(record.observed_objects)]
@@ -73,16 +74,17 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     return Failure(cause="step_limit", detail=f"{record.error or 'step limit'}; {first_unmet} unmet")
 
 
-def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], world: World) -> str:
-    """'placed cup B, the goal needs cup A'-style detail when the robot manipulated another instance of a
-    needed object's category but never the needed one; '' when it did not."""
+def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World) -> str:
+    """'acted on cup B; the goal needs cup A'-style detail when the robot manipulated another instance of a
+    needed object's category, one the goal does not name at all, but never the needed one; '' otherwise."""
+    goal_refs = goal_objects | {world.get(o).label for o in goal_objects if o in world.objects}
     touched = {a.arguments[-1] for a in actions if a.ok and a.name in MANIPULATING and a.arguments}
     for name in needed:
         obj = world.get(name)
         if obj.label in touched or name in touched:
             continue
-        others = sorted(t for t in touched if t not in (name, obj.label)
-                        and (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category)
+        others = sorted(t for t in touched - goal_refs
+                        if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category)
         if others:
             return f"acted on {', '.join(others)}; the goal needs {obj.label}"
     return ""

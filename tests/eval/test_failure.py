@@ -44,6 +44,10 @@ def test_each_cause_from_the_trace(world: World) -> None:
     assert cause(_record(all_goals_met=True)) == "done_not_called"
     assert cause(_record(observed_objects=["bottom_cabinet_0"])) == "never_observed"
     assert cause(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)])) == "wrong_instance"
+    other_goal = GoalCondition(text="(open bottom_cabinet_1)", satisfied=True, objects=["bottom_cabinet_1"])
+    both = _record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)], done_called=True)
+    both.goal_conditions.append(other_goal)
+    assert cause(both) == "done_early"  # bottom_cabinet B is a goal object too: not a wrong instance
     assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "cannot reach canned_food A: no path on the map")])) == "unreachable"
     assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "hand is full; holding apple A")])) == "subpolicy_failure"
     assert cause(_record(actions=[ActionRecord(step=i, name="invalid", ok=False) for i in range(3)])) == "invalid_llm_answers"
