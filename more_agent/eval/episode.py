@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
+from more_agent.eval.failure import classify_failure
 from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.eval.timeline import TimelineWriter
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
@@ -141,6 +142,7 @@ def run_episode(
         record.traceback = redact(traceback.format_exc())
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
+    record.failure = classify_failure(record, world)
     if out_dir is not None:
         t = time.perf_counter()
         _write_map(record, world, Path(out_dir), set(scope.values()))

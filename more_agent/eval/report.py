@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import NamedTuple
 
 from more_agent.errors import UserError
-from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task
+from more_agent.eval.failure import CAUSE_ORDER, cause_counts
+from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task, group_by, system_label
 from more_agent.eval.record import EpisodeRecord
 from more_agent.eval.store import EPISODES_FILE, read_records
 
@@ -82,6 +83,16 @@ def per_task_markdown(records: Sequence[EpisodeRecord]) -> str:
     return _md_table(header, rows)
 
 
+def failure_markdown(records: Sequence[EpisodeRecord]) -> str:
+    """Failure causes per system: episodes per cause (docs/evaluation.md), columns for the causes that occur."""
+    groups = group_by(records, system_label)
+    counts = {k: cause_counts(v) for k, v in groups.items()}
+    causes = [c for c in CAUSE_ORDER if any(c in n for n in counts.values())]
+    header = ["System", "n", "failures", *causes]
+    rows = [[k, str(len(groups[k])), str(sum(n.values())), *(str(n.get(c, 0)) for c in causes)] for k, n in counts.items()]
+    return _md_table(header, rows)
+
+
 def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluation summary") -> str:
     """The whole summary.md: Table I, notes on the metrics, the per-task table."""
     return "\n\n".join(
@@ -91,6 +102,8 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
             "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
             "rTP. Episodes are weighted equally; errored episodes count as failures. rTP is 0 for an "
             "episode that observed none of its goal conditions' objects.",
+            "## Failure causes",
+            failure_markdown(records),
             "## Per task",
             per_task_markdown(records),
         ]

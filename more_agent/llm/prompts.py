@@ -22,7 +22,7 @@ PROMPT_NAMES = ("room", "filter", "plan")
 VLM_PROMPT_NAMES = ("bumble_plan", "bumble_landmark", "bumble_object", "bumble_explore", "bumble_verify")
 """The BUMBLE baselines' prompts (:mod:`more_agent.planners.vlm_prompts` builds their messages with images)."""
 HISTORY_LAST_N = 5
-"""The planner sees the last five actions plus all failed ones (paper Sec. III-C)."""
+"""The planner sees the last five actions plus all failed ones (paper Sec. III-C), and every lasting success."""
 
 _SECTION = re.compile(r"^\[\[(system|user|assistant)\]\]\s*$", re.M)
 
@@ -72,13 +72,21 @@ def skill_api_text(skills: Iterable[Skill]) -> str:
     return "\n".join(f"- {s.signature}: {s.description}" for s in skills)
 
 
+LASTING_SKILLS = frozenset({"go_to_and_grasp", "go_to_and_place_inside", "go_to_and_place_ontop", "go_to_and_open", "go_to_and_close"})
+"""Skills whose success changes the world until undone: the history keeps them beyond the last five."""
+
+
 def history_text(actions: Sequence[HistoryItem], last_n: int = HISTORY_LAST_N) -> str:
-    """The last ``last_n`` actions plus all earlier failed ones, numbered, in order; 'none' if empty."""
+    """The last ``last_n`` actions plus all earlier failed ones (the paper's history) and all earlier
+    successful grasps, placements, openings and closings (what the robot did stays true, and a
+    planner that forgets it redoes it), numbered, in order, each with its feedback (which names the
+    objects: 'placed hammer A inside toolbox A'); 'none' if empty."""
     first_recent = max(0, len(actions) - last_n)
     lines = []
     for i, a in enumerate(actions):
-        if i >= first_recent or not a.ok:
-            outcome = "succeeded" if a.ok else f"failed{': ' + a.feedback if a.feedback else ''}"
+        if i >= first_recent or not a.ok or a.name in LASTING_SKILLS:
+            detail = f": {a.feedback}" if a.feedback else ""
+            outcome = f"succeeded{detail}" if a.ok else f"failed{detail}"
             lines.append(f"{i + 1}. {a.name}({', '.join(a.arguments)}) -> {outcome}")
     return "\n".join(lines) or "none"
 

@@ -1,4 +1,4 @@
-"""Planners: the protocol and registry (``base``), the privileged oracle, and (later) the LLM planners."""
+"""Planners: the protocol and registry (``base``), the privileged oracle, the LLM planners and ``grounded``."""
 
 from more_agent.planners.base import (
     DONE,

@@ -27,8 +27,9 @@ if TYPE_CHECKING:
 DONE = "done"
 """Name of the action that ends an episode."""
 
-DEFAULT_PLANNER = "oracle"
-"""The planner ``more-agent run`` uses when none is given and no LLM is configured."""
+DEFAULT_PLANNER = "grounded"
+"""The planner ``more-agent run`` uses when none is given and no LLM is configured: goal-aware,
+through the scene graph and subpolicies like MORE, no LLM (``oracle`` is the privileged upper bound)."""
 
 
 LLM_DEFAULT_PLANNER = "more"
@@ -38,7 +39,7 @@ LLM_DEFAULT_PLANNER = "more"
 def default_planner(llm: str | None) -> str:
     """The planner to use when the user names none; the one place this default is decided.
 
-    ``more`` when an LLM is configured (``--llm``, the environment or the config file), else the oracle.
+    ``more`` when an LLM is configured (``--llm``, the environment or the config file), else ``grounded``.
     """
     from more_agent.llm import llm_configured, load_llm_config
 
@@ -112,6 +113,7 @@ PlannerFactory = Callable[[str | None], Planner]
 
 _BUILTIN: dict[str, str] = {
     "oracle": "more_agent.planners.oracle:OraclePlanner",
+    "grounded": "more_agent.planners.grounded:GroundedPlanner",
     "more": "more_agent.planners.llm_planner:make_more",
     "moma-llm": "more_agent.planners.llm_planner:make_moma_llm",
     "moma-llm-sr": "more_agent.planners.llm_planner:make_moma_llm_sr",

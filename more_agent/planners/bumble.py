@@ -52,10 +52,11 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
-from more_agent.planners.llm_planner import INVALID, STEPS_FILE, _without_visited_frontiers, make_clients
+from more_agent.planners.llm_planner import INVALID, STEPS_FILE, make_clients
 from more_agent.planners.policies import (
     MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore_frontiers, go_to_and, navigate,
 )
+from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
 from more_agent.planners.vlm_prompts import (
@@ -192,7 +193,7 @@ class BumblePlanner:
         body = self._body()
         self.memory.step = len(self.history)
         self.step_log = StepLog()
-        self.graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
+        self.graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
         self.relevant = self._filter(view) if self.config.filtering else None
@@ -218,7 +219,7 @@ class BumblePlanner:
         self.subtasks.append(action.note if action.name != INVALID else "")
         if self.out_dir is not None:
             self._write_step(self.out_dir, action)
-        return self._body().report(result)
+        return self._body().since_last_report(result)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""

@@ -8,9 +8,13 @@ unexplored areas, and the robot's room and held object. The same view renders th
 valid names for answer validation, applies the LLM filter (paper Sec. III-B, ``xi -> xi_task``) and
 resolves the names in an answer back to scene-graph object ids.
 
-Text format, one line per room (attributes in brackets, as the prompts announce)::
+Text format, one line per room (attributes in brackets, as the prompts announce); each room lists
+its ``floor`` first, so that goals on floors can be expressed (``go_to_and_place_ontop(kitchen_0, floor)``)::
 
-    kitchen_0 (unexplored areas): apple A [inside fridge A], fridge A [closed], table A
+    kitchen_0 (unexplored areas): floor, apple A [inside fridge A], fridge A [closed], table A
+
+Relations are those of the scene graph: as perceived (where the world put things), not guessed
+from boxes, for the simulator's instances.
 """
 
 from __future__ import annotations
@@ -25,6 +29,9 @@ from more_agent.scene_graph.model import ObjectNode, SceneGraph
 
 UNLABELED_ROOM = "unknown_room"
 """Room name stem of regions the room classifier has not labelled yet."""
+
+FLOOR = "floor"
+"""Name of every room's floor in the scene text (floors are the rooms' ground, not graph objects)."""
 
 UNKNOWN_PLACE = "unknown"
 """Robot room shown when the robot is not in any region of the graph."""
@@ -41,6 +48,7 @@ class LanguageOptions(BaseModel):
     spatial_relations: bool = Field(
         default=True, description="Add 'inside X' / 'on top of X' relations among observed objects."
     )
+    floors: bool = Field(default=True, description="List each room's floor ('floor') so goals on floors can be expressed.")
 
 
 @dataclass(frozen=True)
@@ -143,7 +151,7 @@ class SceneView:
         for r in self.rooms:
             if r.name not in kept.rooms and r.name not in always:
                 continue
-            keep = set(kept.rooms.get(r.name, ()))
+            keep = set(kept.rooms.get(r.name, ())) | {FLOOR}
             keep |= {o.relation[1] for o in r.objects if o.name in keep and o.relation is not None}
             rooms.append(replace(r, objects=tuple(o for o in r.objects if o.name in keep)))
         return replace(self, rooms=tuple(rooms))
@@ -164,6 +172,8 @@ def scene_view(graph: SceneGraph, options: LanguageOptions, names: Mapping[str, 
         region = graph.regions[rid]
         objects = [graph.objects[o] for o in region.object_ids if o in graph.objects and not graph.objects[o].held]
         entries = _merge([(shown[o.id], o.id, _state(o), relation_of.get(o.id)) for o in objects])
+        if options.floors:
+            entries = (ObjectText(name=FLOOR, ids=()), *entries)
         rooms.append(RoomText(name=names[rid], region_id=rid, objects=entries, unexplored=bool(region.frontiers)))
     held = graph.held_object
     robot_room = names.get(graph.robot.region_id or "", UNKNOWN_PLACE)

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import logging
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -59,9 +58,9 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.exchanges import Exchange, RecordingClient
 from more_agent.planners.history import append_action
-from more_agent.planners.language import LanguageOptions, SceneView, scene_view
+from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
-from more_agent.planners.policies.skills import pick_target
+from more_agent.planners.policies.skills import pick_target, place_on_floor, without_visited_frontiers
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.viz.graph_plot import save_step_graph
@@ -192,7 +191,7 @@ class LLMPlanner:
         """Build the scene graph, label new regions, put it into words."""
         body = self._body()
         self.exchanges.clear()
-        graph = _without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
+        graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         labels = self._classify_rooms(graph)
         if labels:
             body.builder.set_room_labels(labels)
@@ -232,7 +231,7 @@ class LLMPlanner:
         self.feedback = append_action(self.history, action, result)
         if self.out_dir is not None:
             self._write_step(self.out_dir, self.history[-1])
-        return self._body().report(result)
+        return self._body().since_last_report(result)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""
@@ -312,6 +311,8 @@ class LLMPlanner:
         room = action.arguments[0]
         if action.name == "explore":
             return explore(body, graph, view.room(room).region_id, room)
+        if action.arguments[1] == FLOOR and not view.resolve(room, FLOOR):
+            return _floor_action(body, graph, action, view.room(room).region_id, room)
         target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
         if target is None:
             return ActionResult(ok=False, reason=FailureReason.UNKNOWN_OBJECT,
@@ -343,15 +344,11 @@ class LLMPlanner:
         return self.view
 
 
-def _without_visited_frontiers(graph: SceneGraph, visited: Sequence[tuple[float, float]], radius_m: float) -> SceneGraph:
-    """The graph without frontiers near ones already explored, so the text and explore() agree."""
-    if not visited:
-        return graph
-    regions = {
-        rid: r.model_copy(update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]})
-        for rid, r in graph.regions.items()
-    }
-    return graph.model_copy(update={"regions": regions})
+def _floor_action(body: Embodiment, graph: SceneGraph, action: HighLevelAction, region_id: str, room: str) -> ActionResult:
+    """A skill on a room's floor: only placing on it is possible."""
+    if action.name == "go_to_and_place_ontop":
+        return place_on_floor(body, graph, region_id, room)
+    return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"cannot {action.name} the floor of {room}")
 
 
 def make_more(llm: str | None) -> LLMPlanner:

@@ -4,7 +4,8 @@
 viewpoints). ``build`` (once per step) runs the graph pipeline ``mapping.region_graph`` on the BEV
 (Voronoi graph -> sparsification -> door cuts -> regions (+ sub-region merging) -> Eq. 1 object
 assignment -> frontiers), then gives regions stable ids, reduces everything to the robot's
-navigable component and adds the spatial relations.
+navigable component and adds the spatial relations (as perceived where the instance information
+says how an object rests, from box geometry otherwise).
 
 Region ids: each region keeps an anchor point; at the next build a region inherits the id of the
 old anchor(s) whose nearest node (within ``2 * sparsify_threshold_m``) it contains, the smallest
@@ -58,6 +59,7 @@ class SceneGraphBuilder:
         self._instances: dict[int, InstanceInfo] = {}
         self._viewpoints: dict[int, dict[tuple[int, int], tuple[float, float]]] = {}
         self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._remembered: set[int] = set()
         self._anchors: dict[str, np.ndarray] = {}
         self._next_region = 0
         self._room_labels: dict[str, str] = {}
@@ -82,6 +84,8 @@ class SceneGraphBuilder:
                 removed = self.voxels.clear_instance(iid)
                 if len(removed):
                     self._set_box(iid, removed)
+            if info.held:
+                self._remembered.discard(iid)
             self._instances[iid] = info
         held = [iid for iid, info in self._instances.items() if info.held]
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
@@ -90,6 +94,12 @@ class SceneGraphBuilder:
         for iid in np.unique(instance[np.isfinite(depth)]).tolist():
             if iid > 0:
                 self._viewpoints.setdefault(iid, {})[key] = xy
+
+    def remember(self, iid: int, box_min: Sequence[float], box_max: Sequence[float]) -> None:
+        """An instance the robot put down itself: kept in the graph with this box (world metres) while
+        no frame shows it (e.g. deep in a basket), until it is held again."""
+        self._boxes[iid] = (np.asarray(box_min, dtype=float), np.asarray(box_max, dtype=float))
+        self._remembered.add(iid)
 
     def set_room_labels(self, labels: Mapping[str, str]) -> None:
         """Room labels (region id -> label) applied to this and every later build."""
@@ -105,7 +115,7 @@ class SceneGraphBuilder:
         voxels = self.voxels.instance_voxels()
         for iid, pts in voxels.items():
             self._set_box(iid, pts)
-        known = sorted(i for i in voxels if i in self._instances)
+        known = sorted(i for i in set(voxels) | self._remembered if i in self._instances)
         doors = [voxels[i][:, :2] for i in known if self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
@@ -207,12 +217,7 @@ class SceneGraphBuilder:
                 nav_nodes=sub_index[members].tolist(), object_ids=sorted(region_objects[lab]), frontiers=fr,
             )
 
-        placed = [o for o in obj_nodes.values() if o.category != "door" and not o.held]
-        boxes_min = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
-        boxes_max = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
-        relations = [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
-                     for a, p, b in spatial_relations(boxes_min, boxes_max, tol_m=self.config.relation_tol_m,
-                                                      inside_fraction=self.config.inside_fraction)]
+        relations = self._relations([o for o in obj_nodes.values() if o.category != "door" and not o.held])
 
         robot_node = -1
         labelled_kept = np.flatnonzero(keep & (labels >= 0))
@@ -232,6 +237,23 @@ class SceneGraphBuilder:
             occupancy=OccupancyMap(grid=occ, origin_xy=(float(origin[0]), float(origin[1])),
                                    resolution_m=self.config.resolution_m),
         )
+
+    def _relations(self, placed: list[ObjectNode]) -> list[Relation]:
+        """Spatial relations among the placed objects: as perceived where perception reports how an
+        object rests (what the world did), from box geometry for the others."""
+        ids = {o.id for o in placed}
+        relations = []
+        for o in placed:
+            rests = self._instances[o.instance_id].rests
+            if rests is not None and rests[1] in ids:
+                relations.append(Relation(subject=o.id, predicate=rests[0], object=rests[1]))
+        boxes_min = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
+        boxes_max = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
+        relations += [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
+                      for a, p, b in spatial_relations(boxes_min, boxes_max, tol_m=self.config.relation_tol_m,
+                                                       inside_fraction=self.config.inside_fraction)
+                      if self._instances[placed[a].instance_id].rests is None]
+        return relations
 
     def _object_node(self, iid: int, region_id: str | None) -> ObjectNode:
         info = self._instances[iid]

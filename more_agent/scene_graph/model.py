@@ -55,6 +55,11 @@ class InstanceInfo(_Model):
     category: str = Field(description="Object category, e.g. 'fridge', 'door', 'apple'.")
     open: bool | None = Field(default=None, description="Open state; None when not openable.")
     held: bool = Field(default=False, description="True while the robot holds it.")
+    rests: tuple[Literal["inside", "ontop"], str | None] | None = Field(
+        default=None,
+        description="How it rests as perceived: ('inside' | 'ontop', label of the container / support, None for "
+        "the floor). None when not reported: the builder then derives relations from box geometry.",
+    )
 
 
 class Box3D(_Model):

@@ -55,8 +55,16 @@ def test_history_shows_last_five_and_all_failed() -> None:
     actions = [Action("explore", ["kitchen_0"], ok=(i != 1), feedback="no frontier") for i in range(8)]
     lines = history_text(actions).splitlines()
     assert [line.split(".")[0] for line in lines] == ["2", "4", "5", "6", "7", "8"]
-    assert lines[0] == "2. explore(kitchen_0) -> failed: no frontier" and lines[-1].endswith("succeeded")
+    assert lines[0] == "2. explore(kitchen_0) -> failed: no frontier" and lines[-1].endswith("succeeded: no frontier")
     assert history_text([]) == "none"
+
+
+def test_history_keeps_every_lasting_success_and_names_its_objects() -> None:
+    placed = Action("go_to_and_place_inside", ["kitchen_0", "toolbox A"], ok=True, feedback="placed hammer A inside toolbox A")
+    actions = [placed] + [Action("explore", ["kitchen_0"], ok=True, feedback="explored kitchen_0") for _ in range(7)]
+    lines = history_text(actions).splitlines()
+    assert lines[0] == "1. go_to_and_place_inside(kitchen_0, toolbox A) -> succeeded: placed hammer A inside toolbox A"
+    assert [line.split(".")[0] for line in lines] == ["1", "4", "5", "6", "7", "8"]  # explores: the last five only
 
 
 def test_message_builders_fill_the_paper_fields() -> None:

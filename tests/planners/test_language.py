@@ -74,11 +74,11 @@ def test_filtered_scene_snapshot_keeps_supports_and_robot_room() -> None:
     kept = FilterResult(rooms={"living_room_0": ("door A",), "kitchen_0": ("apple A",)}, unknown_rooms=(), unknown_objects=())
     filtered = view.filtered(kept)
     _check_snapshot("scene_more_filtered", filtered.text())
-    assert [o.name for o in filtered.room("kitchen_0").objects] == ["apple A", "fridge A"]  # fridge: apple's container
+    assert [o.name for o in filtered.room("kitchen_0").objects] == ["floor", "apple A", "fridge A"]  # fridge: apple's container
     only_door = view.filtered(FilterResult(rooms={"living_room_0": ()}, unknown_rooms=(), unknown_objects=()),
                               always={view.robot_room})
     assert [r.name for r in only_door.rooms] == ["kitchen_0", "living_room_0"]
-    assert only_door.room("kitchen_0").objects == ()
+    assert [o.name for o in only_door.room("kitchen_0").objects] == ["floor"]  # floors always stay
 
 
 def test_room_names_are_unique_and_stable() -> None:
@@ -98,7 +98,8 @@ def test_instance_ids_and_classes() -> None:
     assert moma.resolve("kitchen_0", "sofa") == ("sofa A",)  # wrong room: found anywhere
     assert more.resolve(None, "book A") == ("book A",) and more.resolve("kitchen_0", "unicorn A") == ()
     assert "book A" in more.object_names() and "book A" not in more.text()  # held: not in any room
-    assert moma.names()["kitchen_0"] == ["apple", "cabinet", "fridge", "table"]
+    assert moma.names()["kitchen_0"] == ["floor", "apple", "cabinet", "fridge", "table"]
+    assert more.resolve("kitchen_0", "floor") == ()  # floors are rooms' ground, not graph objects
 
 
 def test_filter_prompt_carries_the_scene_text() -> None:

@@ -101,3 +101,18 @@ def test_pick_target_prefers_what_the_skill_can_act_on(looked_around: tuple[Task
     assert pick_target(g, ["fridge A", "fridge Z"], "go_to_and_close", body.xy).id == "fridge Z"
     assert pick_target(g, ["fridge A", "fridge Z"], "go_to_and_open", body.xy).id == "fridge A"
     assert pick_target(g, ["unicorn A"], "navigate", body.xy) is None
+
+
+def test_agent_grid_blind_ring_bumps_and_goals_in_the_robots_component() -> None:
+    grid = np.full((40, 20), FREE)  # [ix, iy], 0.1 m cells
+    grid[8:13, 8:13] = 0  # the unseen spot under the robot at (1.05, 1.05)
+    grid[25, :] = OCCUPIED  # a wall at x = 2.5 m, free space beyond it
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    blind = agent_nav_grid(occupancy, inflation_m=0.25)
+    assert not blind.is_free(1.05, 1.05)  # without the ring the robot stands in a hole
+    ring = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=[(1.05, 1.05)], blind_radius_m=0.5)
+    assert ring.is_free(1.05, 1.05)
+    path, index = path_to_nearest(ring, (1.05, 1.05), [(2.9, 1.0)], snap_m=1.0)
+    assert index == 0 and path.waypoints[-1][0] < 2.5  # snapped to this side of the wall, not beyond it
+    bumped = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=[(1.05, 1.05)], blind_radius_m=0.5, bumped_xy=[(1.6, 1.05)])
+    assert ring.is_free(1.6, 1.05) and not bumped.is_free(1.6, 1.05) and not bumped.is_free(1.45, 1.05)

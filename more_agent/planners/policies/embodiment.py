@@ -4,14 +4,15 @@ Every low-level action goes through :mod:`more_agent.sim.motion` (7.5 cm forward
 most 35 degrees) and is counted; frames are rendered and fused into the
 :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
 moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
-Perception is ground truth as in the paper (S.2): instance attributes are read from the world.
+Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
+rests (inside / on top of what) are read from the world for the instances in view.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -19,7 +20,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult
 from more_agent.sim.motion import full_turn_angles, move_forward, turn
-from more_agent.sim.navgrid import XY
+from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
 
@@ -42,6 +43,11 @@ class PolicyConfig(BaseModel):
     )
     visited_frontier_m: float = Field(
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
+    )
+    blind_radius_m: float = Field(
+        default=0.55, ge=0, description="Unknown cells this close to where the robot has been count as free on "
+        "its map: the camera (1.2 m high, pitched 20 degrees, 90 degree field of view) never sees the floor within "
+        "0.56 m of the robot."
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
@@ -66,11 +72,12 @@ class Embodiment:
         self.observed: set[str] = set()
         """World object names seen so far (for the rTP metric)."""
         self.visited_frontiers: list[XY] = []
+        self._reported_steps, self._reported_path = 0, 1
+        self.bumps: list[XY] = []
+        """Where blocked moves met something (just ahead of the base): obstacles on the robot's map."""
         self.on_frame: Callable[[Frame], None] | None = None
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
-        self._reported_steps = 0
-        self._reported_path = 1
 
     @classmethod
     def for_episode(
@@ -90,29 +97,53 @@ class Embodiment:
         """Robot base position."""
         return (float(self.world.robot.x), float(self.world.robot.y))
 
-    def sense(self) -> None:
+    def sense(self, acted_on: Sequence[str] = ()) -> None:
         """Render a frame from the current pose and fuse it into the scene-graph builder.
 
-        The robot knows what it let go of: an item released since the last frame is reported as no
-        longer held even when no camera sees it (the builder only updates instances it is told about).
+        The robot knows what it did: an item released since the last frame is reported as no longer
+        held, resting where it was put, even when no camera sees it (the builder keeps it at that box
+        until a frame shows it), and the objects in ``acted_on`` (world names: what it just opened or
+        closed) are reported with their new state even when out of view.
         """
         frame = self.renderer.render(self.world)
         if self.on_frame is not None:
             self.on_frame(frame)
         table = instance_table(self.world, frame.instance)
         infos = {
-            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"])
+            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"],
+                            rests=self._rests(d["name"]))
             for i, d in table.items()
         }
         released = self._held if self._held is not None and self._held != self.world.robot.held else None
-        if released is not None:
-            obj = self.world.get(released)
+        for name in [*acted_on, *([released] if released is not None else [])]:
+            obj = self.world.get(name)
             infos.setdefault(obj.instance_id, InstanceInfo(
-                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None, held=False,
+                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None,
+                held=self.world.robot.held == name, rests=self._rests(name),
             ))
+        if released is not None:
+            self.builder.remember(self.world.get(released).instance_id, *self.world.get(released).box())
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
+
+    def since_last_report(self, result: ActionResult) -> ActionResult:
+        """``result`` with the low-level steps and path the robot made since the previous call (the first
+        call's include the initial full turn): what one high-level step reports to the episode loop."""
+        steps, self._reported_steps = self.low_level_steps - self._reported_steps, self.low_level_steps
+        path = self.trajectory[self._reported_path - 1:] if len(self.trajectory) > self._reported_path else []
+        self._reported_path = len(self.trajectory)
+        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
+                            path=path, blocking=result.blocking)
+
+    def _rests(self, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
+        """How a seen object rests, as perception reports it: the world's support link (what the last
+        placement did), the support named by its label (None for a floor); None while held."""
+        obj = self.world.get(name)
+        if obj.parent is None or obj.relation is None:
+            return None if self.world.robot.held == name else ("ontop", None)
+        parent = self.world.get(obj.parent)
+        return obj.relation, parent.label if parent.kind != "floor" else None
 
     def build(self) -> SceneGraph:
         """The scene graph of everything sensed so far, from the robot's position."""
@@ -151,6 +182,9 @@ class Embodiment:
                 result = move_forward(self.world, min(FORWARD_STEP_M, remaining))
                 self.low_level_steps += 1
                 if not result.ok:
+                    reach = FORWARD_STEP_M + DEFAULT_NAV.robot_radius_m
+                    yaw = self.world.robot.yaw
+                    self.bumps.append((self.xy[0] + reach * math.cos(yaw), self.xy[1] + reach * math.sin(yaw)))
                     self.sense()
                     return False
                 remaining -= result.applied
@@ -160,15 +194,6 @@ class Embodiment:
                     self.sense()
         self.sense()
         return True
-
-    def report(self, result: ActionResult) -> ActionResult:
-        """``result`` with the low-level steps and path since the last report (the first report also
-        counts what came before it, such as the initial full turn)."""
-        steps, self._reported_steps = self.low_level_steps - self._reported_steps, self.low_level_steps
-        path = self.trajectory[self._reported_path - 1:] if len(self.trajectory) > self._reported_path else []
-        self._reported_path = len(self.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
-                            path=path, blocking=result.blocking)
 
     def record_jump(self, path: Sequence[XY], steps: int) -> None:
         """Account for a motion a magic action made (its path and low-level steps), then sense."""

@@ -1,7 +1,9 @@
 """Paths on the agent's own map: the BEV occupancy of the scene graph, inflated, as a navigation grid.
 
 Only cells the robot has seen free count as traversable, kept ``plan_inflation_m`` away from mapped
-obstacles (unknown space is not traversable but does not inflate). Shortest paths use the same
+obstacles (unknown space is not traversable but does not inflate), plus the unknown cells close to
+where the robot has stood: the pitched camera never sees the floor right around the robot, and
+without them the robot's own spot is a hole that cuts it off from the map it has seen. Shortest paths use the same
 8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.navgrid.shortest_path`,
 an optimal search like A* with an admissible heuristic), here on what the agent knows.
 """
@@ -10,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy import ndimage
@@ -19,15 +22,38 @@ from more_agent.scene_graph import OccupancyMap, SceneGraph
 from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
 
 
-def agent_nav_grid(occupancy: OccupancyMap, *, inflation_m: float) -> NavGrid:
-    """The traversable raster of the agent's map: seen-free cells at least ``inflation_m`` from obstacles."""
-    grid = np.asarray(occupancy.grid).T  # model is [ix, iy]; NavGrid is [row = y, col = x]
+def agent_nav_grid(
+    occupancy: OccupancyMap, *, inflation_m: float, stood_xy: Sequence[XY] = (), blind_radius_m: float = 0.0,
+    bumped_xy: Sequence[XY] = (),
+) -> NavGrid:
+    """The traversable raster of the agent's map: seen-free cells, and unknown cells within
+    ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
+    ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed)."""
+    grid = np.asarray(occupancy.grid).T.copy()  # model is [ix, iy]; NavGrid is [row = y, col = x]
+    bumps = _cells(occupancy, bumped_xy, grid.shape)
+    grid[bumps[:, 1], bumps[:, 0]] = OCCUPIED
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
-    free = (grid == FREE) & (clearance > inflation_m)
+    known_free = grid == FREE
+    if len(stood_xy) and blind_radius_m > 0:
+        cells = _cells(occupancy, stood_xy, grid.shape)
+        seeds = np.ones(grid.shape, dtype=bool)
+        seeds[cells[:, 1], cells[:, 0]] = False
+        near = ndimage.distance_transform_edt(seeds) * occupancy.resolution_m <= blind_radius_m
+        known_free |= near & (grid != OCCUPIED)
+    free = known_free & (clearance > inflation_m)
     return NavGrid(
         free=free, origin=tuple(occupancy.origin_xy), resolution_m=occupancy.resolution_m,
         closed_doors=frozenset(), door_cells={},
     )
+
+
+def _cells(occupancy: OccupancyMap, points: Sequence[XY], shape: tuple[int, ...]) -> np.ndarray:
+    """(n, 2) integer (ix, iy) cells of the points that lie on the grid of ``shape`` (rows = iy)."""
+    if not len(points):
+        return np.zeros((0, 2), dtype=int)
+    cells = np.floor((np.asarray(points, dtype=float) - occupancy.origin_xy) / occupancy.resolution_m).astype(int)
+    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < shape[1]) & (cells[:, 1] < shape[0])
+    return cells[inside]
 
 
 def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | None]:
@@ -40,8 +66,20 @@ def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | No
     return out
 
 
+def reachable_part(grid: NavGrid, start: XY) -> NavGrid:
+    """The grid reduced to the 8-connected free component the robot (snapped) stands in, so that goals
+    snap to cells it can drive to, never to an island of free space cut off by unknown cells."""
+    cell = grid.snap(*start)
+    if cell is None:
+        return grid
+    components, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
+    return replace(grid, free=components == components[cell])
+
+
 def path_to_nearest(grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: float) -> tuple[PathResult, int | None]:
-    """Shortest path from ``start`` to the nearest reachable goal (goals snapped first) and that goal's index."""
+    """Shortest path from ``start`` to the nearest reachable goal (goals snapped first, to the robot's
+    free component) and that goal's index."""
+    grid = reachable_part(grid, start)
     snapped = snap_goals(grid, goals, snap_m)
     usable = [i for i, g in enumerate(snapped) if g is not None]
     if not usable:

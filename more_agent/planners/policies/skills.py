@@ -18,6 +18,7 @@ from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim import actions
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
+from more_agent.sim.world import floor_name
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
@@ -44,7 +45,8 @@ def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY]) -> tuple[bo
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
-        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m)
+        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
+                              blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps)
         path, index = path_to_nearest(grid, body.xy, goals, snap_m=cfg.goal_snap_m)
         if index is None:
             return False, None, "no path on the map"
@@ -109,7 +111,7 @@ def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode
     result = actions.go_to_and(world, verb, obj.name)
     body.record_jump(result.path, result.low_level_steps)
     if result.ok:
-        body.sense()  # what opening / placing revealed
+        body.sense(acted_on=(obj.name,))  # what opening / placing revealed; the new state even out of view
     return ActionResult(
         ok=result.ok, reason=result.reason, feedback=result.feedback,
         low_level_steps=body.low_level_steps - start, blocking=result.blocking,
@@ -125,3 +127,39 @@ def pick_target(graph: SceneGraph, ids: Sequence[str], skill: str, robot_xy: XY)
     if not suitable:
         return None
     return min(suitable, key=lambda n: (math.dist(n.position[:2], robot_xy), n.id))
+
+
+def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, room: str) -> ActionResult:
+    """Put the held item on the floor: where the robot stands, or in ``region_id`` after driving to the
+    region's navigation node closest to its centre (floors are the rooms themselves, not graph objects)."""
+    start = body.low_level_steps
+    world = body.world
+    if world.robot.held is None:
+        return _fail(FailureReason.HAND_EMPTY, "hand is empty")
+    if region_id is not None and graph.robot.region_id != region_id:
+        region = graph.regions[region_id]
+        nodes = graph.nav.node_xy[region.nav_nodes]
+        if len(nodes) == 0:
+            return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {room}: no map yet")
+        centre = min(((float(x), float(y)) for x, y in nodes), key=lambda p: math.dist(p, region.centroid))
+        reached, _, why = _drive(body, graph, [centre])
+        if not reached:
+            return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {room}: {why}", body.low_level_steps - start)
+    room_id = world.room_at(*body.xy)
+    if room_id is None:
+        return _fail(FailureReason.INVALID_TARGET, "no floor here", body.low_level_steps - start)
+    result = actions.place_ontop(world, floor_name(room_id))
+    body.record_jump(result.path, result.low_level_steps)
+    feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"
+    return ActionResult(ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start)
+
+
+def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:
+    """The graph without frontiers near ones already explored, so the scene text and explore() agree."""
+    if not visited:
+        return graph
+    regions = {
+        rid: r.model_copy(update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]})
+        for rid, r in graph.regions.items()
+    }
+    return graph.model_copy(update={"regions": regions})

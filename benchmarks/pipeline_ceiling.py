@@ -1,0 +1,82 @@
+"""Benchmark: the ceiling our pipeline puts on a language planner, ``grounded`` vs the privileged ``oracle``.
+
+``grounded`` knows the goal like an ideal language model but sees the world only through the
+scene graph and subpolicies; the oracle reads the world. Both run through the evaluation harness
+(``more_agent.eval.harness.evaluate``) over each task set and seed, into resumable run folders under
+``--out`` (``<out>/<task set>/<planner>``, with summary.md holding the failure-cause table).
+
+Prints one JSON line per (task set, planner): n, SR and TP in percent, failures per cause
+(docs/evaluation.md), reach failures on observed targets ("no path on the map", "the way is
+blocked", ...) per 100 high-level steps, and the planner's median plan time per step in ms; then
+one line per task set with the SR and TP gaps. It reads the worlds only through the harness, so it
+runs unchanged on other worlds. Run:
+``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--workers 2] [--limit N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+from pathlib import Path
+
+from more_agent import __version__
+from more_agent.eval.failure import cause_counts, is_reach_failure
+from more_agent.eval.harness import evaluate
+from more_agent.eval.metrics import summarize
+from more_agent.eval.record import EpisodeRecord
+from more_agent.eval.report import SourcedRecord, write_reports
+from more_agent.eval.store import RunConfig
+from more_agent.sim.tasks import task_set
+
+PLANNERS = ("grounded", "oracle")
+
+
+def row(task_set_name: str, planner: str, records: list[EpisodeRecord]) -> dict[str, object]:
+    """The JSON line of one (task set, planner)."""
+    s = summarize(records)
+    steps = sum(r.high_level_steps for r in records)
+    reach = sum(is_reach_failure(a) for r in records for a in r.actions)
+    plan_ms = [1000 * r.timings.get("plan", 0.0) / r.high_level_steps for r in records if r.high_level_steps]
+    return {
+        "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
+        "sr": round(100 * s.SR.mean, 1), "tp": round(100 * s.TP.mean, 1),
+        "causes": dict(sorted(cause_counts(records).items())),
+        "reach_failures_per_100_steps": round(100 * reach / steps, 2) if steps else None,
+        "median_plan_ms_per_step": round(statistics.median(plan_ms), 3) if plan_ms else None,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--task-sets", nargs="+", default=["more-paper", "behavior-rearrange"])
+    parser.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 of every task")
+    parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--limit", type=int, default=None, help="only the first N tasks of each set")
+    parser.add_argument("--out", type=Path, default=Path("runs/pipeline_ceiling"))
+    parser.add_argument("--planners", nargs="+", default=list(PLANNERS))
+    args = parser.parse_args()
+
+    for name in args.task_sets:
+        tasks = task_set(name)[: args.limit]
+        results: dict[str, list[EpisodeRecord]] = {}
+        for planner in args.planners:
+            config = RunConfig(
+                planner=planner, tasks=tasks, seeds=list(range(args.seeds)), episode_fn="more_agent.eval.episode:run_episode",
+                workers=args.workers, more_agent_version=__version__,
+            )
+            run_dir = args.out / name / planner
+            records = evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
+            write_reports([SourcedRecord(r, run_dir) for r in records], run_dir, title=f"{planner} on {name}")
+            results[planner] = records
+            print(json.dumps(row(name, planner, records)), flush=True)
+        if set(PLANNERS) <= set(results):
+            g, o = summarize(results["grounded"]), summarize(results["oracle"])
+            print(json.dumps({
+                "task_set": name, "sr_gap": round(100 * (o.SR.mean - g.SR.mean), 1),
+                "tp_gap": round(100 * (o.TP.mean - g.TP.mean), 1),
+            }), flush=True)
+
+
+if __name__ == "__main__":
+    main()

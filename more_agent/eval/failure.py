@@ -1,0 +1,95 @@
+"""Why an episode failed: one cause per unsuccessful episode, from its own trace and the world's ground truth.
+
+:func:`classify_failure` runs after the episode, for every planner, on the finished record (its
+actions and feedback, error, goal conditions, observed task objects) and the final world. Causes
+are checked in the order of :data:`CAUSE_ORDER`; the first that applies wins (docs/evaluation.md
+defines each). Counts per cause and system are pure functions of records (:func:`cause_counts`).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable, Sequence
+
+from more_agent.eval.record import ActionRecord, EpisodeRecord, Failure, FailureCause
+from more_agent.sim.world import World
+
+CAUSE_ORDER: tuple[FailureCause, ...] = (
+    "llm_error", "other", "done_not_called", "wrong_instance", "never_observed", "invalid_llm_answers",
+    "unreachable", "subpolicy_failure", "done_early", "step_limit",
+)
+"""Causes in the order they are tested; 'other' here means the episode raised (its traceback is kept)."""
+
+UNREACHABLE_FEEDBACK = ("cannot reach", "no path on the map", "the way is blocked", "blocked by closed door")
+"""Feedback fragments of a failed approach (rather than a failed manipulation)."""
+
+INVALID_ACTION = "invalid"
+"""Action name the LLM planners record for an answer still invalid after the re-asks."""
+
+INVALID_SHARE = 0.5
+"""An episode whose share of invalid actions reaches this failed on the LLM's answers."""
+
+MANIPULATING = ("go_to_and_grasp", "go_to_and_place_inside", "go_to_and_place_ontop", "go_to_and_open", "go_to_and_close")
+
+
+def is_reach_failure(action: ActionRecord) -> bool:
+    """Whether a failed action failed on the way to its target (no path, blocked), not at it."""
+    return not action.ok and any(f in action.feedback for f in UNREACHABLE_FEEDBACK)
+
+
+def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | None:
+    """The failure of a finished episode (None for a success); see the module docstring."""
+    if record.success:
+        return None
+    if record.error and record.error.startswith("LLM error"):
+        return Failure(cause="llm_error", detail=record.error)
+    if record.traceback is not None or world is None:
+        return Failure(cause="other", detail=record.error or "the episode did not run")
+    if record.all_goals_met:
+        return Failure(cause="done_not_called", detail=record.error or "every goal condition held; done() never called")
+    unmet = [c for c in record.goal_conditions if not c.satisfied]
+    needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
+    labels = {o: world.get(o).label or o for o in needed}
+    goal_objects = {o for c in record.goal_conditions for o in c.objects}
+    wrong = _wrong_instances(record.actions, needed, goal_objects, world)
+    if wrong:
+        return Failure(cause="wrong_instance", detail=wrong)
+    unseen = [o for o in needed if o not in set(record.observed_objects)]
+    if unseen:
+        return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
+    invalid = sum(a.name == INVALID_ACTION for a in record.actions)
+    if record.actions and invalid / len(record.actions) >= INVALID_SHARE:
+        return Failure(cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers")
+    refs = {ref for o in needed for ref in (o, labels[o])}  # the oracle names world objects, the others labels
+    on_needed = [a for a in record.actions if not a.ok and refs & set(a.arguments)]
+    reach = [a for a in on_needed if is_reach_failure(a)]
+    if reach:
+        return Failure(cause="unreachable", detail=f"{reach[-1].name}({', '.join(reach[-1].arguments)}): {reach[-1].feedback}")
+    if on_needed:
+        last = on_needed[-1]
+        return Failure(cause="subpolicy_failure", detail=f"{last.name}({', '.join(last.arguments)}): {last.feedback}")
+    first_unmet = unmet[0].text if unmet else ""
+    if record.done_called:
+        return Failure(cause="done_early", detail=record.error or f"done() with {first_unmet} unmet")
+    return Failure(cause="step_limit", detail=f"{record.error or 'step limit'}; {first_unmet} unmet")
+
+
+def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World) -> str:
+    """'acted on cup B; the goal needs cup A'-style detail when the robot manipulated another instance of a
+    needed object's category, one the goal does not name at all, but never the needed one; '' otherwise."""
+    goal_refs = goal_objects | {world.get(o).label for o in goal_objects if o in world.objects}
+    touched = {a.arguments[-1] for a in actions if a.ok and a.name in MANIPULATING and a.arguments}
+    for name in needed:
+        obj = world.get(name)
+        if obj.label in touched or name in touched:
+            continue
+        others = sorted(t for t in touched - goal_refs
+                        if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category)
+        if others:
+            return f"acted on {', '.join(others)}; the goal needs {obj.label}"
+    return ""
+
+
+def cause_counts(records: Iterable[EpisodeRecord]) -> Counter[FailureCause]:
+    """Number of episodes per failure cause (successes are not counted)."""
+    return Counter(r.failure.cause for r in records if r.failure is not None)

@@ -1,0 +1,419 @@
+"""The ``grounded`` planner: an ideal reader of the goal, acting only through what the robot observes.
+
+It stands in for a language model that understands the task perfectly. It knows the task's goal in
+BDDL form and its description (:mod:`more_agent.planners.task_goal`), and the world only through
+the same embodiment, scene graph and subpolicies as MORE: no world state, no object positions it
+has not seen, no goal checks. What it reaches is therefore the ceiling that perception, mapping,
+the scene graph and the subpolicies put on any language planner (``benchmarks/pipeline_ceiling.py``).
+
+Every step (MPC style) it rebuilds the scene graph and:
+
+1. binds each goal scope to an observed instance: the label the description names, else the
+   nearest unbound instance of a category that counts as the scope's synset; bindings stay;
+2. evaluates every literal of the goal option on what it believes (observed open state and spatial
+   relations, its own placements on floors) and calls ``done`` when all hold;
+3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
+   before their containers move, closing, the robot's own position) whose objects it knows: open a
+   closed container before placing inside, grasp, place, put down what the hand holds but does
+   not need;
+4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
+   at most while there is a room to explore), explores the
+   room most likely to hold what is missing (BEHAVIOR-1K room inventories; rooms explored three
+   times yield to the others; then the room explored least often, then the nearest), then opens other containers, then closed doors; it gives up with
+   ``done`` when nothing is left to try.
+
+An action that fails twice the same way is not repeated: its target is dropped from the bindings
+(another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
+with the room type their furniture fits best (:mod:`more_agent.planners.room_types`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+
+from more_agent.eval.record import LLMUsage
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.language import room_names
+from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
+from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
+from more_agent.planners.policies.skills import place_on_floor, without_visited_frontiers
+from more_agent.planners.room_types import category_likelihood, likely_room_type
+from more_agent.planners.task_goal import TaskGoal, task_goal
+from more_agent.scene_graph import ObjectNode, SceneGraph
+from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.sim.goals import Literal
+
+FLOOR = "floor"
+"""Object argument of a placement on the floor of a room."""
+
+MAX_FAILURES = 2
+"""An action is not tried again after failing this many times the same way."""
+
+OPENS_BEFORE_EXPLORING = 3
+"""Containers opened to look inside, one after the other, before the search explores again."""
+
+EXPLORES_BEFORE_MOVING_ON = 3
+"""A room explored this often yields to rooms explored less, however likely it is to hold what is missing."""
+
+MAX_REACH_FAILURES = 3
+"""An object is given up after this many failed approaches (the robot explores in between)."""
+
+Relation = tuple[str, str]
+"""(predicate 'inside' / 'ontop', label of the container / support, or 'floor <room>')."""
+
+
+@dataclass(frozen=True)
+class _Step:
+    """A decided action and how to run it."""
+
+    action: HighLevelAction
+    target: str | None = None
+    """Label of the object acted on (None for explore / floor placement)."""
+    region: str | None = None
+    """Region to explore or to put the held item down in."""
+
+
+class GroundedPlanner:
+    """Goal-aware planner on the scene graph (module docstring); no LLM, deterministic."""
+
+    name = "grounded"
+    llm: str | None = None
+
+    def __init__(self, llm: str | None = None, *, config: PolicyConfig | None = None) -> None:
+        del llm  # plans without a language model
+        self.config = config or PolicyConfig()
+
+    # -- Planner protocol ---------------------------------------------------------------------
+    def reset(self, context: EpisodeContext) -> None:
+        """Read the goal, start the robot with a full turn in place (paper S.3)."""
+        self.goal: TaskGoal = task_goal(context.instance, context.goals)
+        self.body = Embodiment.for_episode(context, config=self.config)
+        option = self.goal.options[0]
+        self.skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
+        """Literals no subpolicy can achieve (named when the planner calls done)."""
+        self.literals: list[Literal] = order_literals([lit for lit in option if lit not in self.skipped])
+        self.bound: dict[str, str] = {}
+        self.seen: dict[str, ObjectNode] = {}
+        """Label -> the object as last observed (objects of rooms now out of reach included)."""
+        self.relation: dict[str, Relation | None] = {}
+        """Label -> where it rests as last observed or placed."""
+        self.looked_into: set[str] = set()
+        self.dropped: set[str] = set()
+        self.out_of_reach: dict[str, int] = {}
+        """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
+        self.failures: Counter[tuple[str, tuple[str, ...], str]] = Counter()
+        self.opened_in_a_row = 0
+        self.explored: Counter[str] = Counter()
+        """Region id -> explore() calls so far: rooms are explored breadth first, not one frontier after another."""
+        self.room_types: dict[str, str] = {}
+        self.graph: SceneGraph | None = None
+        self.names: dict[str, str] = {}
+        self._step: _Step | None = None
+        self.body.sense()
+        self.body.look_around()
+
+    def observe(self) -> None:
+        """Build the scene graph; remember what is seen, where it rests and its open state; type rooms."""
+        body = self.body
+        graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.visited_frontier_m)
+        labels = {}
+        for rid, region in graph.regions.items():
+            if region.room_label is None:
+                kind = likely_room_type(graph.objects[o].category for o in region.object_ids)
+                if kind is not None:
+                    labels[rid] = kind
+        if labels:
+            body.builder.set_room_labels(labels)
+            graph = graph.with_room_labels(labels)
+        self.room_types = {rid: r.room_label for rid, r in graph.regions.items() if r.room_label}
+        rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
+        for obj in graph.objects.values():
+            self.seen[obj.label] = obj
+            if obj.open:
+                self.looked_into.add(obj.label)
+            if obj.held:
+                self.relation[obj.label] = None
+            elif obj.label in rel or not _on_floor(self.relation.get(obj.label)):
+                self.relation[obj.label] = rel.get(obj.label)
+        self.graph, self.names = graph, room_names(graph)
+
+    def decide(self) -> HighLevelAction:
+        """``done`` when every goal literal holds as far as the robot knows, else the next action."""
+        self._step = self._decide()
+        looking = self._step.action.name == "go_to_and_open" and self._step.action.note.startswith("looking for")
+        self.opened_in_a_row = self.opened_in_a_row + 1 if looking else 0
+        return self._step.action
+
+    def execute(self, action: HighLevelAction) -> ActionResult:
+        """Run the decided step's subpolicy; the result counts the low-level steps and path since the last one."""
+        return self.body.since_last_report(self._run(action))
+
+    def observed_objects(self) -> set[str]:
+        """World object names the robot has seen."""
+        return set(self.body.observed)
+
+    def llm_usage(self) -> LLMUsage:
+        """No LLM."""
+        return LLMUsage()
+
+    # -- beliefs ------------------------------------------------------------------------------
+    def _label(self, scope: str) -> str | None:
+        """The observed instance a scope is bound to, binding it now if possible (module docstring)."""
+        if scope in self.bound:
+            return self.bound[scope]
+        named = self.goal.named.get(scope)
+        if named is not None:
+            if named in self.seen:
+                self.bound[scope] = named
+            return self.bound.get(scope)
+        taken = set(self.bound.values()) | set(self.goal.named.values()) | self.dropped
+        cats = self.goal.categories.get(scope, frozenset())
+        candidates = [o for o in self.seen.values() if o.category in cats and o.label not in taken]
+        if not candidates:
+            return None
+        xy = self.body.xy
+        best = min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label))
+        self.bound[scope] = best.label
+        return best.label
+
+    def _floor_region(self, scope: str) -> str | None:
+        """A reachable region whose room type is the floor's (any region when the description names none)."""
+        graph = self._graph()
+        want = self.goal.floor_rooms.get(scope)
+        if want is None:
+            return graph.robot.region_id
+        matches = sorted(rid for rid, kind in self.room_types.items() if kind == want)
+        return matches[0] if matches else None
+
+    def _holds(self, lit: Literal) -> bool | None:
+        """Whether ``lit`` holds as far as the robot knows; None while one of its objects is unseen."""
+        if lit.predicate == "open":
+            label = self._label(lit.args[0])
+            if label is None:
+                return None
+            return bool(self.seen[label].open) != lit.negated
+        subject, target = lit.args
+        if subject == self.goal.robot:
+            region = self._floor_region(target)
+            return None if region is None else (self._graph().robot.region_id == region) != lit.negated
+        a = self._label(subject)
+        if a is None:
+            return None
+        rel = self.relation.get(a)
+        if self.goal.is_floor(target):
+            want = self.goal.floor_rooms.get(target)
+            on = _on_floor(rel) and (want is None or rel[1] == f"{FLOOR} {want}")  # type: ignore[index]
+            return on != lit.negated
+        b = self._label(target)
+        if b is None:
+            return None
+        return (rel == (lit.predicate, b)) != lit.negated
+
+    # -- deciding -----------------------------------------------------------------------------
+    def _decide(self) -> _Step:
+        status = [(lit, self._holds(lit)) for lit in self.literals]
+        lost = sorted(label for scope, label in self.bound.items() if label in self.dropped)
+        if lost:
+            why = f"cannot act on {', '.join(lost)}, which the description names"
+            return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up: {why}"))
+        pending = [(lit, h) for lit, h in status if h is not True]
+        if not pending:
+            why = "; ".join(lit.text for lit in self.skipped)
+            return _Step(HighLevelAction(DONE, note="every goal literal holds in the scene graph",
+                                         gave_up=f"goal literals no subpolicy achieves: {why}" if why else ""))
+        held = self._graph().held_object
+        if held is not None:
+            step = self._place_held(held.label, [lit for lit, h in pending if h is False])
+            if step is not None:
+                return step
+        for lit, h in pending:
+            if lit.predicate == "open" and lit.negated and len(pending) > 1:
+                continue  # close last: what is inside may still be needed
+            if h is False:
+                step = self._act_for(lit, held.label if held is not None else None)
+                if step is not None:
+                    return step
+        # Nothing to act on now: find what is unseen, else what is out of reach.
+        missing = next((lit for lit, h in pending if h is None), pending[0][0])
+        return self._search(missing, held.label if held is not None else None)
+
+    def _place_held(self, held: str, unmet: list[Literal]) -> _Step | None:
+        """Place the held item where an unmet literal wants it, when that target is ready."""
+        for lit in unmet:
+            if lit.predicate == "open" or lit.negated or self.bound.get(lit.args[0]) != held:
+                continue
+            target = lit.args[1]
+            if self.goal.is_floor(target):
+                region = self._floor_region(target)
+                if region is not None:
+                    return self._floor_step(region, f"for {lit.text}")
+                continue
+            b = self.bound[target]
+            if b in self._reachable() and not self._must_open(b, lit.predicate):
+                return self._object_step(f"go_to_and_place_{lit.predicate}", b, f"for {lit.text}")
+        return None
+
+    def _act_for(self, lit: Literal, held: str | None) -> _Step | None:
+        """The next action towards an unmet literal whose objects are all known, or None if it cannot act now."""
+        objects = self._reachable()
+        note = f"for {lit.text}"
+        if lit.predicate == "open":
+            label = self.bound[lit.args[0]]
+            if label not in objects:
+                return None
+            if held is not None:
+                return self._put_down(held)
+            return self._object_step("go_to_and_close" if lit.negated else "go_to_and_open", label, note)
+        subject, target = lit.args
+        if subject == self.goal.robot:
+            region = self._floor_region(target)
+            goal_obj = next((o for o in self._graph().objects_in(region)), None) if region else None
+            return self._object_step("navigate", goal_obj.label, note) if goal_obj is not None else None
+        a = self.bound[subject]
+        if a not in objects:
+            return None
+        if not lit.negated and not self.goal.is_floor(target):
+            b = self.bound[target]
+            if b not in objects:
+                return None
+            if self._must_open(b, lit.predicate):
+                return self._put_down(held) if held is not None else self._object_step("go_to_and_open", b, note)
+        if held is not None and held != a:
+            return self._put_down(held)
+        if held == a:  # negated literal: take it away from where it must not be
+            return self._put_down(held)
+        hider = self._closed_container_of(a)
+        if hider is not None:
+            return self._object_step("go_to_and_open", hider, note) if hider in objects else None
+        return self._object_step("go_to_and_grasp", a, note)
+
+    def _closed_container_of(self, label: str) -> str | None:
+        """The closed container ``label`` was last seen (or put) inside, if any."""
+        rel = self.relation.get(label)
+        if rel is None or rel[0] != "inside" or rel[1] not in self.seen:
+            return None
+        return rel[1] if self.seen[rel[1]].open is False else None
+
+    def _reachable(self) -> set[str]:
+        """Labels of objects in the current graph, less those whose approach failed since the robot last moved."""
+        moved = len(self.body.trajectory)
+        return {o for o in self._graph().objects if self.out_of_reach.get(o, -1) != moved}
+
+    def _must_open(self, label: str, predicate: str) -> bool:
+        obj = self.seen[label]
+        return predicate == "inside" and obj.open is False
+
+    def _search(self, lit: Literal, held: str | None) -> _Step:
+        """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
+        containers, closed doors; give up when none is left."""
+        graph = self._graph()
+        missing = [s for s in lit.args if s != self.goal.robot and not self.goal.is_floor(s) and self._label(s) is None]
+        note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
+        here = graph.robot.region_id
+        closed = sorted(
+            (o for o in graph.objects.values()
+             if o.open is False and o.category != "door" and o.label not in self.looked_into and o.label not in self.dropped),
+            key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
+        )
+        region = self._room_to_explore(missing)
+        if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
+            return self._open_to_look(closed[0].label, held, note)
+        if region is not None:
+            return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region)
+        if closed:
+            return self._open_to_look(closed[0].label, held, note)
+        doors = sorted((o for o in graph.objects.values() if o.category == "door" and o.open is False
+                        and o.label not in self.dropped), key=lambda o: math.dist(o.position[:2], self.body.xy))
+        if doors:
+            return self._open_to_look(doors[0].label, held, note)
+        why = f"{note}: nothing left to explore or open"
+        return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+
+    def _open_to_look(self, label: str, held: str | None, note: str) -> _Step:
+        if held is not None:
+            return self._put_down(held)
+        return self._object_step("go_to_and_open", label, note)
+
+    def _room_to_explore(self, missing: list[str]) -> str | None:
+        """The region with unexplored areas most likely to hold the missing furniture, nearest first."""
+        graph = self._graph()
+        cats = [c for s in missing for c in self.goal.categories.get(s, ())]
+
+        def score(rid: str) -> tuple[bool, float, int, float, str]:
+            kind = self.room_types.get(rid)
+            like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
+            return (self.explored[rid] >= EXPLORES_BEFORE_MOVING_ON, -like, self.explored[rid],
+                    math.dist(graph.regions[rid].centroid, self.body.xy), rid)
+
+        open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
+        return min(open_regions, key=score) if open_regions else None
+
+    def _put_down(self, held: str) -> _Step:
+        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(self._graph().robot.region_id), FLOOR),
+                                     note=f"free the hand of {held}"))
+
+    def _floor_step(self, region: str, note: str) -> _Step:
+        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(region), FLOOR), note=note), region=region)
+
+    def _object_step(self, skill: str, label: str, note: str) -> _Step:
+        obj = self._graph().objects[label]
+        return _Step(HighLevelAction(skill, (self._room(obj.region_id), label), note=note), target=label)
+
+    def _room(self, region_id: str | None) -> str:
+        return self.names.get(region_id or "", "unknown")
+
+    # -- acting -------------------------------------------------------------------------------
+    def _run(self, action: HighLevelAction) -> ActionResult:
+        step, body, graph = self._step, self.body, self._graph()
+        if action.name == DONE or step is None:
+            return ActionResult(ok=True, reason=None, feedback="done")
+        if action.name == "explore":
+            assert step.region is not None
+            result = explore(body, graph, step.region, action.arguments[0])
+            self.explored[step.region] += 1
+        elif step.target is None:
+            held = graph.held_object
+            result = place_on_floor(body, graph, step.region, action.arguments[0])
+            if result.ok and held is not None:
+                region = step.region or graph.robot.region_id
+                self.relation[held.label] = ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
+        else:
+            target = graph.objects[step.target]
+            if action.name == "navigate":
+                result = navigate(body, graph, target)
+            else:
+                result = go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
+            if result.ok and action.name == "go_to_and_open":
+                self.looked_into.add(step.target)
+        if not result.ok:
+            self._failed(action, step, result)
+        return result
+
+    def _failed(self, action: HighLevelAction, step: _Step, result: ActionResult) -> None:
+        """Count a failure; an action failing twice the same way drops its target from the bindings."""
+        if step.target is None:
+            return
+        if result.reason is FailureReason.NOT_REACHABLE:
+            self.out_of_reach[step.target] = len(self.body.trajectory)
+            key = (action.name, action.arguments, "not reachable")
+            limit = MAX_REACH_FAILURES
+        else:
+            key, limit = (action.name, action.arguments, result.feedback), MAX_FAILURES
+        self.failures[key] += 1
+        if self.failures[key] < limit:
+            return
+        self.dropped.add(step.target)
+        for scope, label in list(self.bound.items()):
+            if label == step.target and scope not in self.goal.named:
+                del self.bound[scope]
+
+    def _graph(self) -> SceneGraph:
+        if self.graph is None:
+            raise RuntimeError("observe() must be called before decide() / execute()")
+        return self.graph
+
+
+def _on_floor(rel: Relation | None) -> bool:
+    return rel is not None and rel[1].startswith(f"{FLOOR} ")

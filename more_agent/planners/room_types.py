@@ -1,0 +1,49 @@
+"""Room types from the furniture seen in a region, and which room types hold a category.
+
+Both come from BEHAVIOR-1K's scene inventory (bddl's ``combined_room_object_list.json``: 51 scenes,
+their rooms and the furniture categories in each): counts per room type, smoothed. This is the
+prior knowledge a language model brings about houses, made deterministic for the planner that
+runs without one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Iterable
+from functools import cache
+
+from more_agent.sim import catalog
+
+SMOOTHING = 0.5
+"""Additive smoothing of the category counts per room type."""
+
+
+@cache
+def room_type_counts() -> dict[str, Counter[str]]:
+    """Room type ('kitchen') -> furniture category counts over every BEHAVIOR-1K scene."""
+    counts: dict[str, Counter[str]] = {}
+    for scene in catalog.scene_names():
+        for room, objects in catalog.scene_rooms(scene).items():
+            kind = counts.setdefault(room.rsplit("_", 1)[0], Counter())
+            for key, n in objects.items():  # keys are 'category-model'
+                kind[key.rsplit("-", 1)[0]] += n
+    return counts
+
+
+def category_likelihood(category: str, room_type: str) -> float:
+    """Smoothed share of ``room_type``'s furniture that is ``category`` (0 for unknown room types)."""
+    counts = room_type_counts().get(room_type)
+    if counts is None:
+        return 0.0
+    vocabulary = len(set().union(*room_type_counts().values())) + 1
+    return (counts.get(category, 0) + SMOOTHING) / (sum(counts.values()) + SMOOTHING * vocabulary)
+
+
+def likely_room_type(categories: Iterable[str]) -> str | None:
+    """The room type that best explains the furniture categories seen (naive Bayes, uniform prior);
+    None when none of them is furniture any room type lists."""
+    seen = [c for c in categories if any(c in counts for counts in room_type_counts().values())]
+    if not seen:
+        return None
+    return max(sorted(room_type_counts()), key=lambda t: sum(math.log(category_likelihood(c, t)) for c in seen))

@@ -1,0 +1,65 @@
+"""Failure causes from an episode's own trace and the world's ground truth, and their counts in the summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from more_agent.eval.failure import cause_counts, classify_failure
+from more_agent.eval.record import ActionRecord, EpisodeRecord, GoalCondition
+from more_agent.eval.report import summary_markdown
+from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World
+
+KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
+
+
+@pytest.fixture(scope="module")
+def world() -> World:
+    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
+
+
+def _record(**fields: object) -> EpisodeRecord:
+    unmet = GoalCondition(text="(inside canned_food_1 bottom_cabinet_0)", satisfied=False,
+                          objects=["canned_food_1", "bottom_cabinet_0"])
+    base: dict[str, object] = dict(task="t", scene="s", seed=0, planner="grounded", goal_conditions=[unmet],
+                                   observed_objects=["canned_food_1", "bottom_cabinet_0"], high_level_steps=3)
+    return EpisodeRecord(**{**base, **fields})
+
+
+def _act(name: str, target: str, ok: bool, feedback: str = "") -> ActionRecord:
+    return ActionRecord(step=0, name=name, arguments=["kitchen_0", target], ok=ok, feedback=feedback)
+
+
+def test_each_cause_from_the_trace(world: World) -> None:
+    def cause(record: EpisodeRecord) -> str | None:
+        failure = classify_failure(record, world)
+        return None if failure is None else failure.cause
+
+    assert cause(_record(success=True, all_goals_met=True, done_called=True)) is None
+    assert cause(_record(error="LLM error (LLMTimeout): slow")) == "llm_error"
+    assert cause(_record(error="ValueError: x", traceback="...")) == "other"
+    assert cause(_record(all_goals_met=True)) == "done_not_called"
+    assert cause(_record(observed_objects=["bottom_cabinet_0"])) == "never_observed"
+    assert cause(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)])) == "wrong_instance"
+    other_goal = GoalCondition(text="(open bottom_cabinet_1)", satisfied=True, objects=["bottom_cabinet_1"])
+    both = _record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)], done_called=True)
+    both.goal_conditions.append(other_goal)
+    assert cause(both) == "done_early"  # bottom_cabinet B is a goal object too: not a wrong instance
+    assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "cannot reach canned_food A: no path on the map")])) == "unreachable"
+    assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "hand is full; holding apple A")])) == "subpolicy_failure"
+    assert cause(_record(actions=[ActionRecord(step=i, name="invalid", ok=False) for i in range(3)])) == "invalid_llm_answers"
+    assert cause(_record(done_called=True)) == "done_early"
+    assert cause(_record(high_level_steps=50)) == "step_limit"
+    detail = classify_failure(_record(observed_objects=["bottom_cabinet_0"]), world)
+    assert detail is not None and detail.detail == "never observed canned_food A"  # labels, as the robot knows them
+
+
+def test_summary_counts_causes_per_system(world: World) -> None:
+    records = [_record(observed_objects=[]), _record(done_called=True), _record(success=True, all_goals_met=True)]
+    records = [r.model_copy(update={"failure": classify_failure(r, world)}) for r in records]
+    assert cause_counts(records) == {"never_observed": 1, "done_early": 1}
+    md = summary_markdown(records)
+    assert "| System | n | failures | never_observed | done_early |\n" in md and "| grounded | 3 | 2 | 1 | 1 |" in md

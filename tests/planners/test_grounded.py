@@ -1,0 +1,77 @@
+"""The grounded planner: goal knowledge without world state, solving a kitchen task through the scene graph."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from more_agent.eval.episode import run_episode
+from more_agent.eval.record import EpisodeSpec
+from more_agent.planners.base import default_planner, make_planner
+from more_agent.planners.grounded import GroundedPlanner
+from more_agent.planners.room_types import likely_room_type
+from more_agent.planners.task_goal import task_goal
+from more_agent.sim.goals import GoalChecker, GoalStatus
+from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World
+
+KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
+
+
+class BlindGoals(GoalChecker):
+    """The real goal checker, except that checking the goal (privileged) fails the test."""
+
+    def check(self, world: World | None = None) -> GoalStatus:
+        raise AssertionError("the grounded planner checked the goal")
+
+
+@pytest.fixture(scope="module")
+def kitchen() -> TaskInstance:
+    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+
+
+def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen: TaskInstance) -> None:
+    goal = task_goal(kitchen, GoalChecker(kitchen))
+    world_names = set(kitchen.world.objects)
+    assert goal.options and all(not set(lit.args) & world_names for opt in goal.options for lit in opt)
+    assert goal.named == {"electric_refrigerator.n.01_1": "fridge A", "cabinet.n.01_1": "bottom_cabinet A"}
+    assert "fridge" in goal.categories["electric_refrigerator.n.01_1"]
+    assert "egg.n.02_1" not in goal.named  # the description says "dairy", not which instance
+
+
+def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
+    from more_agent.planners.base import EpisodeContext
+
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    actions = []
+    for _ in range(50):
+        planner.observe()
+        action = planner.decide()
+        result = planner.execute(action)
+        actions.append((action.name, action.arguments, result.ok))
+        if action.is_done:
+            break
+    assert actions[-1][0] == "done" and GoalChecker(kitchen).check(kitchen.world).all_met, actions
+    assert all(name != "go_to_and_place_inside" or ok for name, _, ok in actions)  # never places into a closed container
+
+
+def test_grounded_episode_is_deterministic_and_records_no_failure() -> None:
+    spec = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="grounded")
+    first, second = run_episode(spec), run_episode(spec)
+    assert first.success and first.failure is None and first.error is None
+    assert [a.model_dump() for a in first.actions] == [a.model_dump() for a in second.actions]
+    assert first.timings["plan"] / first.high_level_steps < 0.05  # the planner itself: milliseconds a step
+
+
+def test_registry_and_default_without_llm() -> None:
+    assert make_planner("grounded").name == "grounded"
+    assert default_planner(None) in ("grounded", "more")  # 'more' only where an LLM is configured
+
+
+def test_room_types_from_furniture() -> None:
+    assert likely_room_type(["fridge", "oven", "bottom_cabinet_no_top"]) == "kitchen"
+    assert likely_room_type(["toilet"]) == "bathroom" and likely_room_type(["sofa", "coffee_table"]) == "living_room"
+    assert likely_room_type(["unicorn"]) is None  # no room type lists it: no evidence
