@@ -433,7 +433,6 @@ def _driveway(rid: str, rect: Rect, rects: dict[str, Rect], k: dict) -> Rect:
     others = [r for o, r in rects.items() if o != rid]
     hx0 = min((r[0] for r in others), default=x0)
     hy0 = min((r[1] for r in others), default=y0)
-    hx1 = max((r[2] for r in others), default=x1)
     hy1 = max((r[3] for r in others), default=y1)
     if y1 <= hy0 + 1e-6:
         return (x0 + inner, y0 + inner, x1 - inner, y0 + inner + d)

@@ -18,7 +18,9 @@ KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
 @pytest.fixture(scope="module")
 def world() -> World:
-    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
+    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
+    world.assign_labels()  # as after an episode that saw everything: the causes name objects by label
+    return world
 
 
 def _record(**fields: object) -> EpisodeRecord:

@@ -166,7 +166,8 @@ def test_filtering_marks_only_task_objects_and_their_containers(tmp_path: Path) 
     listed = 0
     for r in server.requests:
         if kind(r.body) in ("object", "plan"):
-            entries = [line.split(": ", 1)[1] for line in request_text(r.body).splitlines() if line[:1].isdigit() and ": " in line]
+            marks = (re.match(r"\d+: (.*)", line) for line in request_text(r.body).splitlines())  # not "N. history"
+            entries = [m.group(1) for m in marks if m]
             holders = {m for e in entries for m in re.findall(r"\[inside ([^\]]+)\]", e)}
             assert {re.split(r" \[|, ", e)[0] for e in entries} <= task_objects | holders, entries
             listed += len(entries)

@@ -36,7 +36,7 @@ def _add_on_floor(world: World, name: str, category: str, kind: str, rng: np.ran
 
 
 def _world(seed: int) -> World:
-    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
+    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room").world
     rng = np.random.default_rng(seed)
     for category in CONTAINERS:
         kind = "furniture" if category in ("shelf", "car") else "item"
