@@ -157,6 +157,8 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
         return _fail(FailureReason.INVALID_TARGET, "no floor here", body.low_level_steps - start)
     result = actions.place_ontop(world, floor_name(room_id))
     body.record_jump(result.path, result.low_level_steps)
+    if result.ok:
+        body.sense()  # the hand is empty now: without a frame the graph would still show the item held
     feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"
     return ActionResult(ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start)
 
