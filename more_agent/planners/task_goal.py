@@ -20,6 +20,8 @@ from more_agent.sim.tasks import scope_synset
 
 _FLOOR = re.compile(r"^the (.+) floor$")
 _SCOPE_WORD = re.compile(r"\$([\w.]+?\.n\.\d+_\d+)")
+_INSTANCE_LABEL = re.compile(r"\S+ [A-Z]+")
+"""An instance label ('apple A'); a bare category ('every mail') names no instance."""
 
 FLOOR_SYNSETS = frozenset({"floor.n.01", "lawn.n.01", "driveway.n.01", "carpet.n.01"})
 """Synsets of room grounds: their scopes are floors, placed on where the robot stands."""
@@ -78,8 +80,10 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
 
 def _described_scopes(instance: TaskInstance) -> set[str]:
     """Scopes whose instance the description names: the paper's ``$scope`` words, or the scopes whose
-    label a description generated from the goal contains."""
+    instance label a description generated from the goal contains (a quantified scope is named by its
+    category only: 'every mail' binds no instance)."""
     text = instance.definition.paper_description
     if text is not None:
         return set(_SCOPE_WORD.findall(text)) & set(instance.scope)
-    return {s for s in instance.scope if re.search(rf"\b{re.escape(instance.label(s))}\b", instance.description)}
+    return {s for s in instance.scope
+            if _INSTANCE_LABEL.fullmatch(label := instance.label(s)) and re.search(rf"\b{re.escape(label)}\b", instance.description)}

@@ -77,7 +77,10 @@ class SceneGraphBuilder:
         robot_xy: Sequence[float],
     ) -> None:
         """Fuse one frame and remember, for every instance in view, its attributes and the
-        robot position it was seen from. A newly held instance leaves the voxel map."""
+        robot position it was seen from. A newly held instance leaves the voxel map, and so does a
+        door whose open state changed: rays through an opening pass above the lower part of a leaf
+        seen closed and never clear it, so the doorway would stay blocked (and the room behind
+        unexplored) for good; the cleared cells become frontiers until the room behind is seen."""
         for iid, info in instances.items():
             previous = self._instances.get(iid)
             if info.held and not (previous is not None and previous.held):
@@ -86,6 +89,8 @@ class SceneGraphBuilder:
                     self._set_box(iid, removed)
             if info.held:
                 self._remembered.discard(iid)
+            if info.category == "door" and previous is not None and previous.open is not None and info.open != previous.open:
+                self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks (or is new)
             self._instances[iid] = info
         held = [iid for iid, info in self._instances.items() if info.held]
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)

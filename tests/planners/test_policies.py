@@ -10,6 +10,7 @@ import pytest
 
 from more_agent.mapping import FREE, OCCUPIED
 from more_agent.planners.policies import Embodiment, agent_nav_grid, explore, go_to_and, navigate, path_to_nearest, pick_target
+from more_agent.planners.policies.skills import place_on_floor
 from more_agent.scene_graph import OccupancyMap, SceneGraph
 from more_agent.sim.actions import FailureReason
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
@@ -116,3 +117,15 @@ def test_agent_grid_blind_ring_bumps_and_goals_in_the_robots_component() -> None
     assert index == 0 and path.waypoints[-1][0] < 2.5  # snapped to this side of the wall, not beyond it
     bumped = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=[(1.05, 1.05)], blind_radius_m=0.5, bumped_xy=[(1.6, 1.05)])
     assert ring.is_free(1.6, 1.05) and not bumped.is_free(1.6, 1.05) and not bumped.is_free(1.45, 1.05)
+
+
+def test_the_graph_shows_the_hand_empty_right_after_a_floor_placement() -> None:
+    _, body, graph = fresh()
+    item = next(o for o in graph.objects.values() if o.category == "bottle_of_cooking_oil")
+    assert go_to_and(body, graph, "grasp", item).ok
+    graph = body.build()
+    assert graph.held_object is not None and graph.held_object.id == item.id
+    result = place_on_floor(body, graph, None, "kitchen_0")
+    assert result.ok, result.feedback
+    after = body.build()  # no move since: only the frame the placement took can tell
+    assert after.held_object is None and item.id in after.objects

@@ -37,17 +37,19 @@ def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
     return ActionResult(ok=False, reason=reason, feedback=feedback, low_level_steps=steps)
 
 
-def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY]) -> tuple[bool, int | None, str]:
-    """Drive to the nearest reachable goal on the agent's map, replanning on the updated map when a
-    move is blocked. Returns (reached, goal index, failure feedback)."""
+def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None) -> tuple[bool, int | None, str]:
+    """Drive to the nearest reachable goal on the agent's map (goals off it snapped within ``snap_m``,
+    default ``goal_snap_m``), replanning on the updated map when a move is blocked. Returns (reached,
+    goal index, failure feedback)."""
     cfg = body.config
+    snap_m = cfg.goal_snap_m if snap_m is None else snap_m
     occupancy = graph.occupancy
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
         grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
                               blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps)
-        path, index = path_to_nearest(grid, body.xy, goals, snap_m=cfg.goal_snap_m)
+        path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
         if index is None:
             return False, None, "no path on the map"
         if body.follow(path.waypoints):
@@ -83,14 +85,19 @@ def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[
 
 
 def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionResult:
-    """Drive to the Voronoi node closest to the object on the agent's map, then face it."""
+    """Drive to the Voronoi node closest to the object on the agent's map, then face it. When that node
+    lies in a part of the map the robot cannot drive to (a gap narrower than its clearance, unknown
+    cells between), drive instead to the reachable spot closest to the object within arm's reach
+    (``actions.REACH_M``) of its centre."""
     start = body.low_level_steps
     if target.held:
         return _fail(FailureReason.INVALID_TARGET, f"already holding {target.label}")
     goal = object_goal(graph, target.id)
     if goal is None:
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: no map yet")
-    reached, _, why = _drive(body, graph, [goal])
+    reached, index, why = _drive(body, graph, [goal])
+    if index is None:  # the node is off the robot's part of the map: any spot within arm's reach will do
+        reached, _, why = _drive(body, graph, [target.position[:2]], snap_m=actions.REACH_M)
     if not reached:
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: {why}", body.low_level_steps - start)
     body.face(target.position[:2])
@@ -150,6 +157,8 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
         return _fail(FailureReason.INVALID_TARGET, "no floor here", body.low_level_steps - start)
     result = actions.place_ontop(world, floor_name(room_id))
     body.record_jump(result.path, result.low_level_steps)
+    if result.ok:
+        body.sense()  # the hand is empty now: without a frame the graph would still show the item held
     feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"
     return ActionResult(ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start)
 
