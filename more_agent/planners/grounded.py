@@ -44,6 +44,7 @@ from more_agent.planners.task_goal import TaskGoal, task_goal
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.goals import Literal
+from more_agent.viz.graph_plot import save_step_graph
 
 FLOOR = "floor"
 """Object argument of a placement on the floor of a room."""
@@ -111,6 +112,10 @@ class GroundedPlanner:
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
         self._step: _Step | None = None
+        self._graph_dir = context.out_dir if context.save_graph else None
+        """Where each step's scene graph goes (``--save-graph`` / ``--viewer``), or None."""
+        self._graph_pictures = context.graph_pictures
+        self._steps = 0
         self.body.sense()
         self.body.look_around()
 
@@ -138,6 +143,9 @@ class GroundedPlanner:
             elif obj.label in rel or not _on_floor(self.relation.get(obj.label)):
                 self.relation[obj.label] = rel.get(obj.label)
         self.graph, self.names = graph, room_names(graph)
+        if self._graph_dir is not None:
+            save_step_graph(self._graph_dir, self._steps, graph, picture=self._graph_pictures)
+        self._steps += 1
 
     def decide(self) -> HighLevelAction:
         """``done`` when every goal literal holds as far as the robot knows, else the next action."""
