@@ -13,7 +13,7 @@ import json
 import time
 
 from more_agent.eval.episode import run_episode
-from more_agent.eval.record import EpisodeSpec
+from more_agent.records import EpisodeSpec
 from more_agent.sim.instantiate import InstantiationError
 from more_agent.sim.tasks import task_set
 

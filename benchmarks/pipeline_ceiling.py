@@ -25,9 +25,10 @@ from more_agent import __version__
 from more_agent.eval.failure import cause_counts, is_reach_failure
 from more_agent.eval.harness import evaluate
 from more_agent.eval.metrics import summarize
-from more_agent.eval.record import EpisodeRecord
-from more_agent.eval.report import SourcedRecord, write_reports
+from more_agent.eval.report import SourcedRecord
+from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import RunConfig
+from more_agent.records import EpisodeRecord
 from more_agent.sim.tasks import task_set
 
 PLANNERS = ("grounded", "oracle")

@@ -30,13 +30,14 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec, Failure, LLMUsage  # noqa: E402
-from more_agent.eval.report import SourcedRecord, write_reports  # noqa: E402
+from more_agent.eval.report import SourcedRecord  # noqa: E402
+from more_agent.eval.report_writer import write_reports  # noqa: E402
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname  # noqa: E402
+from more_agent.eval.viewer import VIEWER_FILE, run_episode_with_viewer, write_viewer  # noqa: E402
 from more_agent.llm import LLMConfig, make_client  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402
+from more_agent.records import EpisodeRecord, EpisodeSpec, Failure, LLMUsage  # noqa: E402
 from more_agent.sim.tasks import task_set  # noqa: E402
-from more_agent.viz.viewer import VIEWER_FILE, run_episode_with_viewer, write_viewer  # noqa: E402
 from tests.planners.brain import BrainServer, parse_prompt, plan  # noqa: E402
 
 TASK = "putting_shopping_away"

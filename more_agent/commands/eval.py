@@ -51,7 +51,8 @@ def eval_(
     """
     from more_agent import __version__
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
-    from more_agent.eval.report import load_runs, table_i_markdown, write_reports
+    from more_agent.eval.report import load_runs, table_i_markdown
+    from more_agent.eval.report_writer import write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
     from more_agent.sim.start import check_start

@@ -19,7 +19,8 @@ def report(
     per_task: Annotated[bool, typer.Option(help="Print the per-task table too.")] = False,
 ) -> None:
     """Print Table I (SR / TTC / TP / rTP with 95% intervals) over the merged runs."""
-    from more_agent.eval.report import load_runs, per_task_markdown, table_i_markdown, write_reports
+    from more_agent.eval.report import load_runs, per_task_markdown, table_i_markdown
+    from more_agent.eval.report_writer import write_reports
 
     sourced, dropped = load_runs(run_dirs)
     records = [s.record for s in sourced]

@@ -16,7 +16,7 @@ from rich.text import Text
 
 from more_agent.commands._common import EXIT_FAILED, EXIT_RETRYABLE, console, user_errors_exit_2
 from more_agent.errors import check_writable_dir
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.records import EpisodeRecord, EpisodeSpec
 
 NO_LLM_MESSAGE = (
     "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
@@ -45,7 +45,7 @@ def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Pa
 def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     """A short summary of an episode for the terminal (record text shown as plain text, never markup)."""
     from more_agent.eval.episode import EPISODE_FILE, MAP_FILE
-    from more_agent.viz.viewer import VIEWER_FILE
+    from more_agent.eval.viewer import VIEWER_FILE
 
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_column(style="bold")
@@ -88,9 +88,8 @@ def run(
     75 when that error is transient (the LLM unreachable: run it again), 2 for bad input.
     """
     from more_agent.eval.episode import ended_abnormally, run_episode
-    from more_agent.viz.viewer import run_episode_with_viewer
+    from more_agent.eval.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
-
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task
 

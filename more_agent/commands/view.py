@@ -16,7 +16,7 @@ def view(
     out: Annotated[Path | None, typer.Option(help="HTML file to write (default: EPISODE_DIR/viewer.html).")] = None,
 ) -> None:
     """Write an HTML page that steps through the episode: frames, map, scene text, LLM requests and answers."""
-    from more_agent.viz.viewer import write_viewer
+    from more_agent.eval.viewer import write_viewer
 
     path = write_viewer(episode_dir, out)
     err_console.print(f"wrote {path} (open it in a browser; left/right arrow keys move between steps)", highlight=False)

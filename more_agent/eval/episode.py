@@ -23,10 +23,10 @@ from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
 from more_agent.eval.failure import classify_failure
-from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.eval.timeline import TimelineWriter
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
+from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.redaction import redact
 from more_agent.sim.navgrid import XY
 
@@ -102,7 +102,7 @@ def run_episode(
     replay miss) ends the episode with ``record.error`` naming it, everything so far kept.
     ``viewer`` (with ``out_dir``) saves what the episode viewer reads: frames and scene graphs, without
     the slow per-step graph pictures unless ``save_graph`` asks for them
-    (``more_agent.viz.viewer.run_episode_with_viewer`` then writes the page).
+    (``more_agent.eval.viewer.run_episode_with_viewer`` then writes the page).
     """
     from more_agent.llm.errors import LLMAuthError, LLMBadRequest, LLMError, LLMTransportError
     from more_agent.sim.goals import GoalChecker

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterable, Sequence
 
-from more_agent.eval.record import ActionRecord, EpisodeRecord, Failure, FailureCause
+from more_agent.records import ActionRecord, EpisodeRecord, Failure, FailureCause
 from more_agent.sim.world import World
 
 CAUSE_ORDER: tuple[FailureCause, ...] = (

@@ -8,13 +8,11 @@ Records are appended to ``DIR/episodes.jsonl`` by this (parent) process only, as
 
 from __future__ import annotations
 
-import importlib
 import json
 import multiprocessing
 import os
 import threading
 import time
-import traceback
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -25,8 +23,6 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
 from more_agent.errors import UserError, unknown_name_error
-from more_agent.eval.limits import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.eval.runlock import locked_run_dir
 from more_agent.eval.store import (
     EPISODE_DIRS,
@@ -39,18 +35,19 @@ from more_agent.eval.store import (
     prepare_run_dir,
     retire_retryable,
 )
+from more_agent.eval.worker import error_record, execute_episode, resolve_episode_fn
 from more_agent.interrupts import interrupted
-from more_agent.redaction import redact
+from more_agent.llm.concurrency import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
+from more_agent.records import EpisodeRecord, EpisodeSpec
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
-VIEWER_EPISODE_FN = "more_agent.viz.viewer:run_episode_with_viewer"
+VIEWER_EPISODE_FN = "more_agent.eval.viewer:run_episode_with_viewer"
 """The real episode function that also writes each episode's viewer (``more-agent eval --viewer``)."""
 
 DEFAULT_MAX_RETRIES = 2
 """Re-runs of an episode whose worker process died before it is recorded as an error."""
 
-EpisodeFn = Callable[..., EpisodeRecord]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -117,59 +114,6 @@ def config_specs(config: RunConfig) -> list[EpisodeSpec]:
         for t in config.tasks
         for s in config.seeds
     ]
-
-
-def episode_fn_path(fn: str | EpisodeFn) -> str:
-    """The dotted path of an episode function; a callable must be a module-level function."""
-    if isinstance(fn, str):
-        return fn
-    path = f"{fn.__module__}:{fn.__qualname__}"
-    if "<" in path or fn.__module__ == "__main__":
-        raise UserError(f"episode function {path} must be a top-level function of an importable module")
-    return path
-
-
-def resolve_episode_fn(path: str) -> EpisodeFn:
-    """Import an episode function from 'pkg.module:function' (or 'pkg.module.function')."""
-    module, sep, name = path.partition(":")
-    if not sep:
-        module, _, name = path.rpartition(".")
-    try:
-        fn = getattr(importlib.import_module(module), name)
-    except (ImportError, AttributeError, ValueError) as e:
-        raise UserError(f"cannot import episode function {path!r}: {e}") from None
-    if not callable(fn):
-        raise UserError(f"episode function {path!r} is not callable")
-    return fn
-
-
-# ---------------------------------------------------------------------------------------------
-# Running one episode (in any process)
-
-
-def error_record(spec: EpisodeSpec, error: str, tb: str | None = None, *, retryable: bool = False) -> EpisodeRecord:
-    """The record of an episode that raised or whose worker died: a failure with its (redacted) error.
-
-    ``retryable`` marks a transient cause (worker death, LLM transport) that ``--retry-errors`` re-runs.
-    """
-    return EpisodeRecord.for_spec(
-        spec, error=redact(error), traceback=redact(tb) if tb else None, retryable=retryable
-    )
-
-
-def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:
-    """Run one episode; an exception becomes an error record. Idempotent: writes only its own dir."""
-    out_dir = Path(run_dir) / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
-    start = time.perf_counter()
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        record = resolve_episode_fn(fn_path)(spec, out_dir=out_dir)
-        if not isinstance(record, EpisodeRecord):
-            raise TypeError(f"episode function returned {type(record).__name__}, not EpisodeRecord")
-        return record
-    except Exception as e:  # noqa: BLE001 - any episode failure is recorded, the run goes on
-        rec = error_record(spec, f"{type(e).__name__}: {e}", traceback.format_exc())
-        return rec.model_copy(update={"timings": {"total": time.perf_counter() - start}})
 
 
 def _exit_when_orphaned(parent_pid: int) -> None:

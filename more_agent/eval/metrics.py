@@ -30,7 +30,7 @@ from collections.abc import Callable, Iterable, Sequence
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from more_agent.eval.record import EpisodeRecord
+from more_agent.records import EpisodeRecord
 
 Z_95 = 1.959963984540054
 """Two-sided 95% normal quantile."""

@@ -16,9 +16,9 @@ from types import ModuleType
 from typing import Any
 
 from more_agent.errors import UserError
-from more_agent.eval.harness import error_record, execute_episode
-from more_agent.eval.limits import SlotContext, set_llm_limiter
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.worker import error_record, execute_episode
+from more_agent.llm.concurrency import SlotContext, set_llm_limiter
+from more_agent.records import EpisodeRecord, EpisodeSpec
 
 
 def import_ray() -> ModuleType:

@@ -1,5 +1,5 @@
 """Reports of evaluation runs: Table I (summary.md), per-task tables, summary.csv, report.html, the
-comparison plots (``more_agent.viz.report_plots``); merging runs.
+comparison plots (``more_agent.eval.report_plots``); merging runs.
 
 Rows of Table I are systems (planner, plus LLM when there is one); every cell is the mean in percent
 with its 95% interval; n and the number of errored episodes are their own columns.
@@ -16,8 +16,8 @@ from typing import NamedTuple
 from more_agent.errors import UserError
 from more_agent.eval.failure import CAUSE_ORDER, cause_counts
 from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task, group_by, system_label
-from more_agent.eval.record import EpisodeRecord
 from more_agent.eval.store import EPISODES_FILE, read_records
+from more_agent.records import EpisodeRecord
 
 SUMMARY_MD = "summary.md"
 SUMMARY_CSV = "summary.csv"
@@ -120,22 +120,3 @@ def summary_csv(records: Sequence[EpisodeRecord]) -> str:
         est = [getattr(s, m) for m in METRIC_NAMES]
         w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *(f"{v:.6f}" for e in est for v in (e.mean, e.low, e.high))])
     return buf.getvalue()
-
-
-def write_reports(sourced: Sequence[SourcedRecord], out_dir: Path, *, title: str = "Evaluation summary") -> list[Path]:
-    """Write summary.md, summary.csv, report.html and the comparison plots (PNG) into ``out_dir``;
-    return their paths."""
-    from more_agent.viz.report_html import render_report  # lazy: only reports need the HTML code
-    from more_agent.viz.report_plots import write_plots
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    records = [s.record for s in sourced]
-    plots = write_plots(records, out_dir)
-    paths = [out_dir / SUMMARY_MD, out_dir / SUMMARY_CSV, out_dir / REPORT_HTML]
-    figures = "\n".join(f"![{p.stem}]({p.name})" for p in plots)
-    paths[0].write_text(summary_markdown(records, title=title) + (f"\n## Plots\n\n{figures}\n" if plots else ""), encoding="utf-8")
-    paths[1].write_text(summary_csv(records), encoding="utf-8")
-    paths[2].write_text(render_report(sourced, title=title, out_dir=out_dir, plots=plots), encoding="utf-8")
-    return paths + plots
-

@@ -18,8 +18,8 @@ from types import TracebackType
 from pydantic import BaseModel, Field, ValidationError
 
 from more_agent.errors import UserError, check_writable_dir
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.eval.runlock import LOCK_FILE
+from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import redact as redact_text
 
 EPISODES_FILE = "episodes.jsonl"

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from more_agent.eval.record import EpisodeRecord
+from more_agent.records import EpisodeRecord
 
 if TYPE_CHECKING:
     from more_agent.sim.goals import GoalStatus

@@ -16,9 +16,9 @@ from typing import Any, Protocol
 
 from pydantic import BaseModel
 
-from more_agent.eval.limits import llm_limiter
 from more_agent.llm.cache import CachedAnswer, ResponseCache, request_key
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
+from more_agent.llm.concurrency import llm_limiter
 from more_agent.llm.config import CacheMode, ModelPrice
 from more_agent.llm.errors import OversizeAnswer, ReplayMiss, Unparseable
 from more_agent.llm.images import cache_view, image_stats

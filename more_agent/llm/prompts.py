@@ -59,7 +59,7 @@ def render_prompt(name: str, **fields: str) -> list[ChatMessage]:
 
 
 class HistoryItem(Protocol):
-    """An executed action as the history shows it (:class:`more_agent.eval.record.ActionRecord` fits)."""
+    """An executed action as the history shows it (:class:`more_agent.records.ActionRecord` fits)."""
 
     name: str
     arguments: list[str]

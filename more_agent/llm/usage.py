@@ -49,7 +49,7 @@ class UsageMeter:
     """Running totals of LLM calls; tokens count every answer, cost only what was actually paid.
 
     One meter per episode (or per client); ``add`` each :class:`~more_agent.llm.completion.Completion`.
-    Field names match :class:`more_agent.eval.record.LLMUsage` so ``LLMUsage(**meter.totals())`` works.
+    Field names match :class:`more_agent.records.LLMUsage` so ``LLMUsage(**meter.totals())`` works.
     """
 
     calls: int = 0

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
 from more_agent.errors import UserError, unknown_name_error
-from more_agent.eval.record import LLMUsage
+from more_agent.records import LLMUsage
 from more_agent.sim.actions import ActionResult
 
 if TYPE_CHECKING:

@@ -43,7 +43,6 @@ from typing import Any, TypeVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from more_agent.eval.record import ActionRecord, LLMUsage
 from more_agent.llm import FilterAnswer, InvalidAnswer, LLMClient, UsageMeter, ask_validated, parse_filter_answer
 from more_agent.llm.completion import ChatMessage, Completion
 from more_agent.llm.images import png_bytes
@@ -54,15 +53,31 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
 from more_agent.planners.llm_planner import INVALID, STEPS_FILE, make_clients
 from more_agent.planners.policies import (
-    MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore_frontiers, go_to_and, navigate,
+    MANIPULATION_SKILLS,
+    Embodiment,
+    PolicyConfig,
+    explore_frontiers,
+    go_to_and,
+    navigate,
 )
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
 from more_agent.planners.vlm_prompts import (
-    FrameAnswer, MarkAnswer, Picture, StepAnswer, VerifyAnswer, frame_captions, frames_messages, object_messages,
-    parse_choice, parse_step, parse_verdict, step_messages,
+    FrameAnswer,
+    MarkAnswer,
+    Picture,
+    StepAnswer,
+    VerifyAnswer,
+    frame_captions,
+    frames_messages,
+    object_messages,
+    parse_choice,
+    parse_step,
+    parse_verdict,
+    step_messages,
 )
+from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY

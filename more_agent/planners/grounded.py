@@ -33,7 +33,6 @@ import math
 from collections import Counter
 from dataclasses import dataclass
 
-from more_agent.eval.record import LLMUsage
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.language import room_names
 from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
@@ -41,6 +40,7 @@ from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, Policy
 from more_agent.planners.policies.skills import place_on_floor, without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, likely_room_type
 from more_agent.planners.task_goal import TaskGoal, task_goal
+from more_agent.records import LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.goals import Literal

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from more_agent.eval.record import ActionRecord
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import HighLevelAction
+from more_agent.records import ActionRecord
 from more_agent.sim.actions import ActionResult
 
 

@@ -29,7 +29,6 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from more_agent.eval.record import ActionRecord, LLMUsage
 from more_agent.llm import (
     DEFAULT_SKILLS,
     FilterAnswer,
@@ -61,6 +60,7 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
 from more_agent.planners.policies.skills import pick_target, place_on_floor, without_visited_frontiers
+from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.viz.graph_plot import save_step_graph

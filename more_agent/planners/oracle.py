@@ -22,9 +22,9 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import replace
 
-from more_agent.eval.record import LLMUsage
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.policies import Embodiment
+from more_agent.records import LLMUsage
 from more_agent.sim.actions import (
     ActionResult,
     FailureReason,

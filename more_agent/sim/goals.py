@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_ground_goal_state_options
 from bddl.condition_evaluation import evaluate_state
 
-from more_agent.eval.record import GoalCondition
 from more_agent.errors import UserError
+from more_agent.records import GoalCondition
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.world import World
 

@@ -1,1 +1,1 @@
-"""Pictures of maps, scene graphs and trajectories, and the HTML evaluation report."""
+"""Pictures of maps, scene graphs, trajectories and sensor frames: drawing only (the reports live in eval)."""

@@ -7,7 +7,7 @@ import time
 import zlib
 from pathlib import Path
 
-from more_agent.eval.record import ActionRecord, EpisodeRecord, EpisodeSpec, GoalCondition, LLMUsage
+from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, GoalCondition, LLMUsage
 
 
 def deterministic_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
@@ -69,7 +69,7 @@ def limited_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> Episod
 
     The record's ``timings['holders']`` is the most holders seen at once (1 when the limit is 1).
     """
-    from more_agent.eval.limits import llm_limiter
+    from more_agent.llm.concurrency import llm_limiter
 
     assert out_dir is not None
     marks = out_dir.parent / "_llm_marks"

@@ -8,8 +8,8 @@ import pytest
 
 from more_agent.errors import UserError
 from more_agent.eval.episode import run_episode
-from more_agent.eval.record import EpisodeSpec
 from more_agent.planners.base import DONE
+from more_agent.records import EpisodeSpec
 
 SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
 

@@ -6,9 +6,9 @@ from pathlib import Path
 
 from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
 from more_agent.eval.metrics import rtp
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec, LLMUsage
 from more_agent.planners.base import EpisodeContext, HighLevelAction
 from more_agent.planners.oracle import OraclePlanner
+from more_agent.records import EpisodeRecord, EpisodeSpec, LLMUsage
 from more_agent.sim.actions import ActionResult
 
 SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.failure import cause_counts, classify_failure
-from more_agent.eval.record import ActionRecord, EpisodeRecord, GoalCondition
 from more_agent.eval.report import summary_markdown
+from more_agent.records import ActionRecord, EpisodeRecord, GoalCondition
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World

@@ -14,9 +14,10 @@ from pathlib import Path
 import pytest
 
 from more_agent.errors import UserError
-from more_agent.eval.harness import config_specs, episode_fn_path, evaluate, resolve_episode_fn, resolve_tasks
-from more_agent.eval.record import EpisodeRecord
+from more_agent.eval.harness import config_specs, evaluate, resolve_tasks
 from more_agent.eval.store import RunConfig, read_records
+from more_agent.eval.worker import episode_fn_path, resolve_episode_fn
+from more_agent.records import EpisodeRecord
 from tests.eval import fake_episodes
 
 REPO = Path(__file__).resolve().parents[2]

@@ -17,7 +17,7 @@ from more_agent.eval.metrics import (
     ttc,
     wilson_interval,
 )
-from more_agent.eval.record import EpisodeRecord, GoalCondition
+from more_agent.records import EpisodeRecord, GoalCondition
 
 
 def rec(task: str = "t", *, conds: list[tuple[bool, list[str]]] = (), observed: list[str] = (), **kw) -> EpisodeRecord:

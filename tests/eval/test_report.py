@@ -10,10 +10,11 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from more_agent.cli import app
-from more_agent.eval.record import ActionRecord, EpisodeRecord, GoalCondition
-from more_agent.eval.report import SourcedRecord, load_runs, summary_csv, summary_markdown, write_reports
+from more_agent.eval.report import SourcedRecord, load_runs, summary_csv, summary_markdown
+from more_agent.eval.report_html import render_report
+from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import EpisodeWriter, episode_dirname
-from more_agent.viz.report_html import render_report
+from more_agent.records import ActionRecord, EpisodeRecord, GoalCondition
 
 PNG = base64.b64decode(
     "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNk+M9QDwADhgGAWjR9awAAAABJRU5ErkJggg=="

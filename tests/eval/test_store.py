@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 
 from more_agent.errors import UserError
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
 from more_agent.eval.runlock import RunFolderBusy, locked_run_dir
 from more_agent.eval.store import (
     EpisodeWriter,
@@ -24,6 +23,7 @@ from more_agent.eval.store import (
     redact,
     retire_retryable,
 )
+from more_agent.records import EpisodeRecord, EpisodeSpec
 
 
 def rec(task: str, seed: int = 0, scene: str = "Rs_int") -> EpisodeRecord:

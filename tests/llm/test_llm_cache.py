@@ -7,17 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from more_agent.llm import (
-    CacheMode,
-    ChatMessage,
-    LLMConfig,
-    ReplayMiss,
-    ResponseCache,
-    RoomLabelAnswer,
-    make_client,
-)
-from more_agent.eval.limits import SlotContext, set_llm_limiter
+from more_agent.llm import CacheMode, ChatMessage, LLMConfig, ReplayMiss, ResponseCache, RoomLabelAnswer, make_client
 from more_agent.llm.cache import CachedAnswer
+from more_agent.llm.concurrency import SlotContext, set_llm_limiter
 from tests.fakes.openai_server import FakeOpenAIServer, Reply
 
 MESSAGES = [ChatMessage(role="user", content="objects: bed, wardrobe")]

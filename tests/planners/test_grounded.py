@@ -7,11 +7,11 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import run_episode
-from more_agent.eval.record import EpisodeSpec
 from more_agent.planners.base import default_planner, make_planner
 from more_agent.planners.grounded import GroundedPlanner
 from more_agent.planners.room_types import likely_room_type
 from more_agent.planners.task_goal import task_goal
+from more_agent.records import EpisodeSpec
 from more_agent.sim.goals import GoalChecker, GoalStatus
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.scene import load_scene

@@ -24,11 +24,11 @@ import pytest
 from typer.testing import CliRunner
 
 from more_agent.cli import app
-from more_agent.eval.record import EpisodeRecord
 from more_agent.llm import FilterAnswer, LLMConfig, PlanAnswer, RoomLabelAnswer, make_client
 from more_agent.llm.jsontext import json_schema_of
 from more_agent.llm.llamacpp_backend import GGUF_CHAT_FORMAT, LlamaCppBackend, _load
 from more_agent.llm.local_models import bundled_model_path
+from more_agent.records import EpisodeRecord
 
 pytestmark = pytest.mark.real_llm
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from more_agent.eval.record import GoalCondition
 from more_agent.planners.base import EpisodeContext, make_planner
 from more_agent.planners.oracle import ORACLE_PREDICATES, OraclePlanner, literal_holds, merge_placements, order_literals
+from more_agent.records import GoalCondition
 from more_agent.sim.goals import GoalStatus, Literal
 from more_agent.sim.world import World
 from tests.sim.test_navgrid import two_room_world
@@ -133,7 +133,7 @@ def test_unseen_closed_doors_one_after_another_are_progress_not_failure():
     """A far random start: the way to the fridge crosses several closed doors the robot has not seen
     (feedback names each only as 'closed door'); opening them one by one must not count as failing."""
     from more_agent.eval.episode import run_episode
-    from more_agent.eval.record import EpisodeSpec
+    from more_agent.records import EpisodeSpec
 
     record = run_episode(EpisodeSpec(task="putting_leftovers_away", scene="house_double_floor_lower", seed=0))
     blocked = [a for a in record.actions if not a.ok and "blocked by closed door" in a.feedback]

@@ -28,7 +28,7 @@ from PIL import Image
 
 from more_agent.errors import UserError
 from more_agent.eval.episode import EPISODE_FILE, run_episode
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.records import EpisodeRecord, EpisodeSpec
 
 log = logging.getLogger(__name__)
 
@@ -238,7 +238,7 @@ def render_viewer(data: dict[str, Any]) -> str:
     """The HTML page for ``viewer_data``'s dict."""
     r = data["record"]
     title = f"{r['task']} | {r['scene']} | seed {r['seed']} | {r['planner']}" + (f" ({r['llm']})" if r["llm"] else "")
-    template = files("more_agent.viz").joinpath("templates/viewer.html").read_text(encoding="utf-8")
+    template = files("more_agent.eval").joinpath("templates/viewer.html").read_text(encoding="utf-8")
     return template.replace("__TITLE__", escape(title)).replace("__DATA__", safe_json(data))
 
 

@@ -11,9 +11,9 @@ from typer.testing import CliRunner
 
 from more_agent.cli import app
 from more_agent.eval.timeline import TIMELINE_FILE
+from more_agent.eval.viewer import VIEWER_FILE, render_viewer, safe_json, scene_segments, step_frame_indices, viewer_data
 from more_agent.planners.llm_planner import STEPS_FILE
-from more_agent.viz.viewer import VIEWER_FILE, render_viewer, safe_json, scene_segments, step_frame_indices, viewer_data
-from tests.viz.conftest import EVIL, Episode
+from tests.eval.conftest import EVIL, Episode
 
 
 def test_every_llm_request_and_answer_is_in_its_step(llm_episode: Episode) -> None:
@@ -98,7 +98,7 @@ def test_view_command_writes_the_page_and_refuses_other_folders(oracle_episode: 
 
 
 def test_run_and_eval_take_viewer(tmp_path: Path) -> None:
-    from tests.viz.conftest import KITCHEN, TASK
+    from tests.eval.conftest import KITCHEN, TASK
 
     out = tmp_path / "ep"
     result = CliRunner().invoke(app, ["run", TASK, "--scene", str(KITCHEN), "--out", str(out), "--viewer"])
@@ -111,7 +111,7 @@ def test_run_and_eval_take_viewer(tmp_path: Path) -> None:
 
 
 def test_an_episode_folder_with_only_its_record_still_opens(tmp_path: Path) -> None:
-    from more_agent.eval.record import ActionRecord, EpisodeRecord
+    from more_agent.records import ActionRecord, EpisodeRecord
 
     record = EpisodeRecord(task="t", scene="s", seed=0, planner="oracle", trajectory=[(0.0, 0.0), (1.0, 1.0)],
                            actions=[ActionRecord(step=0, name="navigate", arguments=["x"], ok=False, feedback=EVIL)],
@@ -128,7 +128,7 @@ def test_images_of_vlm_requests_become_small_thumbnails(tmp_path: Path) -> None:
 
     from PIL import Image
 
-    from more_agent.eval.record import ActionRecord, EpisodeRecord
+    from more_agent.records import ActionRecord, EpisodeRecord
 
     buf = io.BytesIO()
     Image.new("RGB", (512, 512), (200, 30, 30)).save(buf, format="PNG")

@@ -10,10 +10,10 @@ from typing import Any
 
 import pytest
 
-from more_agent.eval.record import EpisodeRecord, EpisodeSpec
+from more_agent.eval.viewer import run_episode_with_viewer
 from more_agent.llm import LLMConfig, make_client
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
-from more_agent.viz.viewer import run_episode_with_viewer
+from more_agent.records import EpisodeRecord, EpisodeSpec
 from tests.planners.brain import BrainServer, plan
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"

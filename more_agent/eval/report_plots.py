@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from more_agent.eval.metrics import METRIC_NAMES, by_system, by_task, group_by, system_label  # noqa: E402
-from more_agent.eval.record import EpisodeRecord  # noqa: E402
+from more_agent.records import EpisodeRecord  # noqa: E402
 
 PLOT_FILES = {
     "metrics": "plot_metrics.png",

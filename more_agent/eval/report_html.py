@@ -17,10 +17,10 @@ from pathlib import Path
 from urllib.parse import quote
 
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
-from more_agent.eval.record import EpisodeRecord
 from more_agent.eval.report import SourcedRecord, fmt
 from more_agent.eval.store import EPISODE_DIRS, episode_dirname
-from more_agent.viz.viewer import VIEWER_FILE
+from more_agent.eval.viewer import VIEWER_FILE
+from more_agent.records import EpisodeRecord
 
 THUMB_PX = 160
 """Width and height of episode thumbnails, in CSS pixels."""

@@ -6,8 +6,8 @@ from pathlib import Path
 
 from PIL import Image
 
-from more_agent.eval.record import EpisodeRecord, Failure, LLMUsage
-from more_agent.viz.report_plots import PLOT_FILES, failure_reason, write_plots
+from more_agent.eval.report_plots import PLOT_FILES, failure_reason, write_plots
+from more_agent.records import EpisodeRecord, Failure, LLMUsage
 
 
 def rec(task: str, planner: str, **kw: object) -> EpisodeRecord:

@@ -8,11 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from more_agent.eval.report import SourcedRecord, write_reports
+from more_agent.eval.report import SourcedRecord
+from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname
-from more_agent.viz.viewer import VIEWER_FILE
-from tests.viz.chromium import Chromium, chromium_or_skip
-from tests.viz.conftest import EVIL, Episode
+from more_agent.eval.viewer import VIEWER_FILE
+from tests.eval.chromium import Chromium, chromium_or_skip
+from tests.eval.conftest import EVIL, Episode
 
 ARROW_RIGHT, ARROW_LEFT = ("ArrowRight", 39), ("ArrowLeft", 37)
 

@@ -1,0 +1,26 @@
+"""Writing a run's reports: summary.md, summary.csv, report.html and the comparison plots."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from more_agent.eval.report import REPORT_HTML, SUMMARY_CSV, SUMMARY_MD, SourcedRecord, summary_csv, summary_markdown
+from more_agent.eval.report_html import render_report
+from more_agent.eval.report_plots import write_plots
+
+
+def write_reports(sourced: Sequence[SourcedRecord], out_dir: Path, *, title: str = "Evaluation summary") -> list[Path]:
+    """Write summary.md, summary.csv, report.html and the comparison plots (PNG) into ``out_dir``;
+    return their paths."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    records = [s.record for s in sourced]
+    plots = write_plots(records, out_dir)
+    paths = [out_dir / SUMMARY_MD, out_dir / SUMMARY_CSV, out_dir / REPORT_HTML]
+    figures = "\n".join(f"![{p.stem}]({p.name})" for p in plots)
+    paths[0].write_text(summary_markdown(records, title=title) + (f"\n## Plots\n\n{figures}\n" if plots else ""), encoding="utf-8")
+    paths[1].write_text(summary_csv(records), encoding="utf-8")
+    paths[2].write_text(render_report(sourced, title=title, out_dir=out_dir, plots=plots), encoding="utf-8")
+    return paths + plots
+

@@ -1,0 +1,66 @@
+"""Running one episode in any process: the episode function named by its dotted path, and the record
+of an episode that raised or whose worker died. Shared by the process pool and the Ray backend."""
+
+from __future__ import annotations
+
+import importlib
+import time
+import traceback
+from collections.abc import Callable
+from pathlib import Path
+
+from more_agent.errors import UserError
+from more_agent.eval.store import EPISODE_DIRS, episode_dirname
+from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.redaction import redact
+
+EpisodeFn = Callable[..., EpisodeRecord]
+
+
+def episode_fn_path(fn: str | EpisodeFn) -> str:
+    """The dotted path of an episode function; a callable must be a module-level function."""
+    if isinstance(fn, str):
+        return fn
+    path = f"{fn.__module__}:{fn.__qualname__}"
+    if "<" in path or fn.__module__ == "__main__":
+        raise UserError(f"episode function {path} must be a top-level function of an importable module")
+    return path
+
+
+def resolve_episode_fn(path: str) -> EpisodeFn:
+    """Import an episode function from 'pkg.module:function' (or 'pkg.module.function')."""
+    module, sep, name = path.partition(":")
+    if not sep:
+        module, _, name = path.rpartition(".")
+    try:
+        fn = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError, ValueError) as e:
+        raise UserError(f"cannot import episode function {path!r}: {e}") from None
+    if not callable(fn):
+        raise UserError(f"episode function {path!r} is not callable")
+    return fn
+
+
+def error_record(spec: EpisodeSpec, error: str, tb: str | None = None, *, retryable: bool = False) -> EpisodeRecord:
+    """The record of an episode that raised or whose worker died: a failure with its (redacted) error.
+
+    ``retryable`` marks a transient cause (worker death, LLM transport) that ``--retry-errors`` re-runs.
+    """
+    return EpisodeRecord.for_spec(
+        spec, error=redact(error), traceback=redact(tb) if tb else None, retryable=retryable
+    )
+
+
+def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:
+    """Run one episode; an exception becomes an error record. Idempotent: writes only its own dir."""
+    out_dir = Path(run_dir) / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+    start = time.perf_counter()
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        record = resolve_episode_fn(fn_path)(spec, out_dir=out_dir)
+        if not isinstance(record, EpisodeRecord):
+            raise TypeError(f"episode function returned {type(record).__name__}, not EpisodeRecord")
+        return record
+    except Exception as e:  # noqa: BLE001 - any episode failure is recorded, the run goes on
+        rec = error_record(spec, f"{type(e).__name__}: {e}", traceback.format_exc())
+        return rec.model_copy(update={"timings": {"total": time.perf_counter() - start}})
