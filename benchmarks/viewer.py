@@ -62,7 +62,9 @@ def fifty_step_episode(out: Path, scene: str) -> EpisodeRecord:
                            cache_path=out.parent / "cache.sqlite")
         client = make_client("openai:scripted", config)
         planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, "openai:scripted"))
-        spec = EpisodeSpec(task=TASK, scene=scene, seed=0, planner="more", llm="openai:scripted")
+        # Started in the task room: the scripted explorer never opens doors, and a random start behind
+        # closed doors would leave it nothing to explore (a short, unrepresentative page).
+        spec = EpisodeSpec(task=TASK, scene=scene, seed=0, planner="more", llm="openai:scripted", start="task-room")
         return run_episode_with_viewer(spec, planner=planner, out_dir=out)
 
 
