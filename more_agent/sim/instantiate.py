@@ -40,6 +40,7 @@ from more_agent.sim import catalog
 from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
 from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
 from more_agent.sim.floorspots import free_floor_spot
+from more_agent.sim.matching import maximum_matching
 from more_agent.sim.scene import Scene
 from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
 from more_agent.sim.tasks import (
@@ -279,17 +280,14 @@ class _Builder:
 
     def _match_room(self, room_id: str, scopes: list[str]) -> dict[str, str]:
         """Largest one-to-one assignment of scopes to this room's furniture / doors of matching category."""
-        graph = nx.Graph()
-        graph.add_nodes_from(("s", s) for s in scopes)
         door_rooms = {d.id: d.rooms for d in self.world.scene.doors}
-        for s in scopes:
-            cats = set(catalog.synset_categories(scope_synset(s)))
-            for obj in self.world.objects.values():
-                in_room = obj.room == room_id or room_id in door_rooms.get(obj.name, ())
-                if in_room and obj.kind in ("furniture", "door") and obj.category in cats:
-                    graph.add_edge(("s", s), ("o", obj.name))
-        matching = nx.bipartite.maximum_matching(graph, top_nodes=[("s", s) for s in scopes])
-        return {s: matching[("s", s)][1] for s in scopes if ("s", s) in matching}
+        candidates = [
+            obj for obj in self.world.objects.values()
+            if obj.kind in ("furniture", "door") and (obj.room == room_id or room_id in door_rooms.get(obj.name, ()))
+        ]
+        cats = {s: set(catalog.synset_categories(scope_synset(s))) for s in scopes}
+        matching = maximum_matching(scopes, candidates, lambda s, obj: obj.category in cats[s])
+        return {s: obj.name for s, obj in matching.items()}
 
     # -- step 3: new items --------------------------------------------------------------------------
     def create_items(self) -> None:

@@ -24,11 +24,11 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
-import networkx as nx
 import numpy as np
 
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.sim import catalog
+from more_agent.sim.matching import maximum_matching
 
 REARRANGE_PREDICATES = frozenset({"inside", "ontop", "open"})
 """Goal predicates of the behavior-rearrange set."""
@@ -210,18 +210,12 @@ def room_matches(room_objects: dict[str, int], required: Counter[str]) -> list[s
     counts: Counter[str] = Counter()
     for key, n in room_objects.items():
         counts[key.rsplit("-", 1)[0]] += n
-    graph = nx.Graph()
-    need = []
-    for synset, n in required.items():
-        ok = set(synset_categories(synset))
-        for i in range(n):
-            node = ("need", synset, i)
-            graph.add_node(node)
-            need.append(node)
-            for cat in ok & counts.keys():
-                graph.add_edges_from((node, ("have", cat, j)) for j in range(counts[cat]))
-    matching = nx.bipartite.maximum_matching(graph, top_nodes=need) if graph.number_of_edges() else {}
-    return sorted({node[1] for node in need if node not in matching})
+    need = [(synset, i) for synset, n in sorted(required.items()) for i in range(n)]
+    # a category can serve at most len(need) scopes: no need to list more of its objects
+    have = [(cat, j) for cat in sorted(counts) for j in range(min(counts[cat], len(need)))]
+    ok = {synset: set(synset_categories(synset)) for synset in required}
+    matching = maximum_matching(need, have, lambda n, h: h[0] in ok[n[0]])
+    return sorted({node[0] for node in need if node not in matching})
 
 
 def scene_mismatch(task: TaskDefinition, rooms: dict[str, dict[str, int]]) -> str:
