@@ -120,3 +120,26 @@ def test_open_literals_and_closed_containers() -> None:
             name = inst.scope[(lit[1] if lit[0] == "not" else lit)[1]]
             assert inst.world.get(name).is_open == (lit[0] == "open")
     _check_init(inst)
+
+
+_DIGEST = """
+import hashlib
+from more_agent.sim.instantiate import instantiate
+world = instantiate("putting_dishes_away_after_cleaning", None, 2).world
+state = sorted((o.name, o.instance_id, o.parent, o.relation, o.label, tuple(o.center.round(4))) for o in world.objects.values())
+print(hashlib.sha256(repr(state).encode()).hexdigest())
+"""
+
+
+def test_instantiation_is_the_same_under_every_string_hash_seed() -> None:
+    """Two cabinets fit the task's cabinet scope: which one it binds must not follow Python's set order."""
+    import os
+    import subprocess
+    import sys
+
+    digests = {
+        subprocess.run([sys.executable, "-c", _DIGEST], env={**os.environ, "PYTHONHASHSEED": seed},
+                       capture_output=True, text=True, check=True).stdout
+        for seed in ("1", "2")
+    }
+    assert len(digests) == 1, digests
