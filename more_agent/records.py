@@ -27,20 +27,22 @@ FailureCause = Literal[
 """Why an unsuccessful episode failed; the classes are documented in docs/evaluation.md."""
 
 
-class GoalCondition(BaseModel):
-    """One conjunct of the grounded goal option that was closest to being met."""
+class FrozenModel(BaseModel):
+    """A pydantic model that is a value: it cannot be changed once built."""
 
     model_config = ConfigDict(frozen=True)
+
+
+class GoalCondition(FrozenModel):
+    """One conjunct of the grounded goal option that was closest to being met."""
 
     text: str = Field(description="The literal in BDDL form, e.g. '(inside apple.n.01_1 fridge.n.01_1)'.")
     satisfied: bool = Field(description="Whether the literal held in the final world state.")
     objects: list[str] = Field(default_factory=list, description="Instance names the literal mentions.")
 
 
-class ActionRecord(BaseModel):
+class ActionRecord(FrozenModel):
     """One high-level action (subpolicy call or magic action) and its feedback."""
-
-    model_config = ConfigDict(frozen=True)
 
     step: int = Field(description="High-level step index, from 0.")
     name: str = Field(description="Subpolicy or action name, e.g. 'go_to_and_grasp'.")
@@ -66,10 +68,8 @@ class LLMUsage(BaseModel):
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 
-class WorldStats(BaseModel):
+class WorldStats(FrozenModel):
     """How hard the episode's world was: its size, its clutter and how far the robot starts from the task."""
-
-    model_config = ConfigDict(frozen=True)
 
     objects: int = Field(description="Objects in the world (furniture and items, task objects included).")
     task_objects: int = Field(description="Objects bound to the task's object scope.")
@@ -81,10 +81,8 @@ class WorldStats(BaseModel):
     )
 
 
-class Failure(BaseModel):
+class Failure(FrozenModel):
     """The cause of an unsuccessful episode, from its own trace and the world's ground truth afterwards."""
-
-    model_config = ConfigDict(frozen=True)
 
     cause: FailureCause = Field(description="The failure class (docs/evaluation.md).")
     detail: str = Field(default="", description="One line naming the objects, literal or reason involved.")
@@ -138,10 +136,8 @@ class EpisodeRecord(BaseModel):
         )
 
 
-class EpisodeSpec(BaseModel):
+class EpisodeSpec(FrozenModel):
     """What to run: one (task, scene, seed, planner, llm) combination; the unit of evaluation work."""
-
-    model_config = ConfigDict(frozen=True)
 
     task: str = Field(description="BEHAVIOR-1K activity name.")
     scene: str | None = Field(default=None, description="Scene name; None draws one with the seed among the task's suitable scenes.")

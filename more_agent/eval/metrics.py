@@ -26,11 +26,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
+from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
-from more_agent.records import EpisodeRecord
+from more_agent.records import EpisodeRecord, FrozenModel
 
 Z_95 = 1.959963984540054
 """Two-sided 95% normal quantile."""
@@ -72,22 +73,18 @@ PER_EPISODE: dict[str, Callable[[EpisodeRecord], float]] = {"SR": sr, "TTC": ttc
 """Metric name -> per-episode value function."""
 
 
-class Estimate(BaseModel):
+class Estimate(FrozenModel):
     """A mean over episodes with its 95% confidence interval."""
-
-    model_config = ConfigDict(frozen=True)
 
     mean: float = Field(description="Mean over episodes, in [0, 1].")
     low: float = Field(description="Lower end of the 95% interval.")
     high: float = Field(description="Upper end of the 95% interval.")
     n: int = Field(description="Number of episodes.")
-    method: str = Field(description="'wilson' or 'bootstrap'.")
+    method: Literal["wilson", "bootstrap"] = Field(description="How the interval was computed.")
 
 
-class MetricSummary(BaseModel):
+class MetricSummary(FrozenModel):
     """The four Table I metrics over one group of episodes, plus counts."""
-
-    model_config = ConfigDict(frozen=True)
 
     n: int = Field(description="Episodes in the group.")
     n_tasks: int = Field(description="Distinct tasks in the group.")

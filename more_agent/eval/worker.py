@@ -17,16 +17,6 @@ from more_agent.redaction import redact
 EpisodeFn = Callable[..., EpisodeRecord]
 
 
-def episode_fn_path(fn: str | EpisodeFn) -> str:
-    """The dotted path of an episode function; a callable must be a module-level function."""
-    if isinstance(fn, str):
-        return fn
-    path = f"{fn.__module__}:{fn.__qualname__}"
-    if "<" in path or fn.__module__ == "__main__":
-        raise UserError(f"episode function {path} must be a top-level function of an importable module")
-    return path
-
-
 def resolve_episode_fn(path: str) -> EpisodeFn:
     """Import an episode function from 'pkg.module:function' (or 'pkg.module.function')."""
     module, sep, name = path.partition(":")

@@ -18,9 +18,9 @@ from typing import TYPE_CHECKING, Protocol
 
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.records import LLMUsage
-from more_agent.sim.actions import ActionResult
 
 if TYPE_CHECKING:
+    from more_agent.sim.actions import ActionResult
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import TaskInstance
 

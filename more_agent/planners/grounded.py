@@ -126,7 +126,7 @@ class GroundedPlanner:
         labels = {}
         for rid, region in graph.regions.items():
             if region.room_label is None:
-                kind = likely_room_type(graph.objects[o].category for o in region.object_ids)
+                kind = likely_room_type(o.category for o in graph.objects_in(rid))
                 if kind is not None:
                     labels[rid] = kind
         if labels:

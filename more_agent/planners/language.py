@@ -170,7 +170,7 @@ def scene_view(graph: SceneGraph, options: LanguageOptions, names: Mapping[str, 
     rooms = []
     for rid in sorted(graph.regions, key=lambda r: names[r]):
         region = graph.regions[rid]
-        objects = [graph.objects[o] for o in region.object_ids if o in graph.objects and not graph.objects[o].held]
+        objects = graph.objects_in(rid)
         entries = _merge([(shown[o.id], o.id, _state(o), relation_of.get(o.id)) for o in objects])
         if options.floors:
             entries = (ObjectText(name=FLOOR, ids=()), *entries)

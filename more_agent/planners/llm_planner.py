@@ -261,7 +261,7 @@ class LLMPlanner:
         a region whose answer stays invalid is left unlabelled and asked again next step."""
         labels: dict[str, str] = {}
         for rid, region in sorted(graph.regions.items()):
-            names = sorted({graph.objects[o].category for o in region.object_ids if graph.objects[o].category != "door"})
+            names = sorted({o.category for o in graph.objects_in(rid) if o.category != "door"})
             if region.room_label is not None or not names:
                 continue
             try:

@@ -33,34 +33,21 @@ from more_agent.sim.actions import (
     go_to_and,
     navigate_to,
 )
-from more_agent.sim.bddl_backend import ROBOT_NAME, is_ontop
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
+from more_agent.sim.predicates import ROBOT_NAME
+from more_agent.sim.tasks import REARRANGE_PREDICATES
 from more_agent.sim.world import World, WorldObject
 from more_agent.viz.graph_plot import save_step_graph
 
-ORACLE_PREDICATES = frozenset({"inside", "ontop", "open"})
-"""Goal predicates the oracle knows how to achieve."""
+ORACLE_PREDICATES = REARRANGE_PREDICATES
+"""Goal predicates the oracle knows how to achieve: those of a rearrangement."""
 
 PUT_DOWN_MAX_TOP_M = 1.5
 """Furniture taller than this (trees, wardrobes) is not used to put things down on."""
 
 MAX_FAILURES_PER_ACTION = 2
 """The oracle gives up once the same action has failed this many times."""
-
-
-def literal_holds(world: World, lit: Literal) -> bool:
-    """Whether a supported literal holds in ``world`` (the same semantics as the bddl backend)."""
-    if lit.predicate == "open":
-        obj = world.get(lit.args[0])
-        value = obj.openable and obj.is_open
-    elif lit.predicate == "ontop" and lit.args[0] == ROBOT_NAME:
-        value = world.room_at(world.robot.x, world.robot.y) == world.get(lit.args[1]).room
-    elif lit.predicate == "ontop":
-        value = is_ontop(world, lit.args[0], lit.args[1])
-    else:
-        value = world.is_inside(lit.args[0], lit.args[1])
-    return value != lit.negated
 
 
 def unsupported_reason(world: World, lit: Literal) -> str | None:
@@ -139,7 +126,7 @@ def choose_option(goals: GoalChecker, world: World, exclude: set[int] = frozense
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)
         unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
-        unmet = sum(unsupported_reason(world, lit) is None and not literal_holds(world, lit) for lit in lits)
+        unmet = sum(unsupported_reason(world, lit) is None and not lit.holds(world) for lit in lits)
         return unsupported, unmet, i
     candidates = [i for i in range(goals.n_options) if i not in exclude]
     return min(candidates, key=cost) if candidates else None
@@ -209,13 +196,13 @@ class OraclePlanner:
         """``done`` when the goal holds (or nothing more can be done), else the next subpolicy."""
         if self._goals.check(self._world).all_met:
             return HighLevelAction(DONE, note="all goal conditions hold")
-        pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
+        pending = [lit for lit in self._literals if not lit.holds(self._world)]
         while not pending:
             # bddl's ground options can be partly infeasible (e.g. '(ontop log_1 log_1)'): the next may finish the job.
             explanation = self._explain_unmet()
             if not self._adopt_next_option():
                 return HighLevelAction(DONE, gave_up=explanation)
-            pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
+            pending = [lit for lit in self._literals if not lit.holds(self._world)]
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:

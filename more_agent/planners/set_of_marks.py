@@ -46,10 +46,6 @@ class MarkedImage:
     rgb: np.ndarray
     marks: tuple[Mark, ...]
 
-    def instance_of(self, number: int) -> int | None:
-        """The instance id behind mark ``number``, or None when there is no such mark."""
-        return next((m.instance_id for m in self.marks if m.number == number), None)
-
 
 def mark_anchor(mask: np.ndarray) -> tuple[int, int]:
     """(u, v) of the mask pixel farthest from the mask's border (ties: first in row-major order)."""

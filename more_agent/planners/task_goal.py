@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass
 
 from more_agent.sim import catalog
-from more_agent.sim.bddl_backend import ROBOT_NAME
+from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.instantiate import TaskInstance
 from more_agent.sim.tasks import scope_synset

@@ -29,13 +29,16 @@ VLM_SKILLS: tuple[Skill, ...] = tuple(Skill(s.name, (), s.description.replace(" 
 
 
 class _Answer(BaseModel):
+    """Every answer gives its reasoning first."""
+
     model_config = ConfigDict(extra="forbid")
+
+    reasoning: str = Field(description="Why.")
 
 
 class StepAnswer(_Answer):
     """The step decision."""
 
-    reasoning: str = Field(description="Why.")
     subtask: str = Field(description="The next subtask in words, e.g. 'grasp apple A'.")
     skill: str = Field(description="Name of the skill that achieves it.")
 
@@ -43,14 +46,12 @@ class StepAnswer(_Answer):
 class FrameAnswer(_Answer):
     """A frame chosen among the numbered frames of a request."""
 
-    reasoning: str = Field(description="Why.")
     frame: int = Field(description="Frame number as offered.")
 
 
 class MarkAnswer(_Answer):
     """A mark chosen in an annotated frame."""
 
-    reasoning: str = Field(description="Why.")
     mark: int = Field(description="Mark number as listed.")
 
 

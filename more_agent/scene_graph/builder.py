@@ -201,12 +201,10 @@ class SceneGraphBuilder:
         kept = set(np.unique(labels[keep & (labels >= 0)]).tolist())
 
         obj_nodes: dict[str, ObjectNode] = {}
-        region_objects: dict[int, list[str]] = {lab: [] for lab in kept}
         for iid, lab in zip(objects, rg.assigned.tolist()):
             if lab in kept:
                 node = self._object_node(iid, region_ids[lab])
                 obj_nodes[node.id] = node
-                region_objects[lab].append(node.id)
         held = [iid for iid, info in self._instances.items() if info.held and iid in self._boxes]
         for iid in held:
             node = self._object_node(iid, None)
@@ -219,7 +217,7 @@ class SceneGraphBuilder:
             fr = [tuple(map(float, p)) for p, n in zip(rg.frontier_xy, frontier_node) if n >= 0 and labels[n] == lab]
             regions[rid] = RegionNode(
                 id=rid, room_label=self._room_labels.get(rid), centroid=tuple(map(float, graph.xy[members].mean(0))),
-                nav_nodes=sub_index[members].tolist(), object_ids=sorted(region_objects[lab]), frontiers=fr,
+                nav_nodes=sub_index[members].tolist(), frontiers=fr,
             )
 
         relations = self._relations([o for o in obj_nodes.values() if o.category != "door" and not o.held])
@@ -228,13 +226,11 @@ class SceneGraphBuilder:
         labelled_kept = np.flatnonzero(keep & (labels >= 0))
         if labelled_kept.size:
             robot_node = labelled_kept[np.argmin(np.linalg.norm(graph.xy[labelled_kept] - robot, axis=1))]
-        held_id = self._instances[held[0]].label if held else None  # object ids are instance labels
         self._step += 1
         return SceneGraph(
             step=self._step - 1,
             robot=RobotNode(position=(float(robot[0]), float(robot[1])),
-                            region_id=region_ids[labels[robot_node]] if robot_node >= 0 else None,
-                            held_object=held_id),
+                            region_id=region_ids[labels[robot_node]] if robot_node >= 0 else None),
             regions=regions, objects=obj_nodes, relations=relations,
             nav=NavGraphData(node_xy=graph.xy[keep], edges=sub_index[graph.edges[emask]],
                              weights=graph.weights[emask], door_edges=rg.cut[emask],

@@ -29,7 +29,7 @@ def to_networkx(graph: SceneGraph, *, include_nav: bool = False) -> nx.DiGraph:
     g = nx.DiGraph()
     g.add_node(ROOT_ID, layer=Layer.ROOT.value, robot=graph.robot.model_dump())
     for rid, region in graph.regions.items():
-        g.add_node(rid, layer=Layer.REGION.value, **region.model_dump(exclude={"id", "nav_nodes", "object_ids"}))
+        g.add_node(rid, layer=Layer.REGION.value, **region.model_dump(exclude={"id", "nav_nodes"}))
         g.add_edge(ROOT_ID, rid, kind="contains")
     for oid, obj in graph.objects.items():
         g.add_node(oid, layer=Layer.OBJECT.value, **obj.model_dump(exclude={"id"}))

@@ -5,6 +5,12 @@ sparse Voronoi navigation graph and the BEV occupancy grid. Versioned JSON via p
 
 Ids: regions are ``region_<k>``; objects are keyed by their alphabetical instance label
 (e.g. ``"fridge A"``); the root is ``"root"``.
+
+Each relation of the hierarchy is stored once: an object names its region (``ObjectNode.region_id``;
+``SceneGraph.objects_in`` derives a region's objects) and says whether the robot holds it
+(``ObjectNode.held``; ``SceneGraph.held_object`` derives the robot's). ``SceneGraph`` checks on
+construction that a held object has no region, every other object's region is in the graph and the
+robot holds at most one object.
 """
 
 from __future__ import annotations
@@ -13,10 +19,10 @@ from enum import Enum
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSerializer, PrivateAttr
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSerializer, PrivateAttr, model_validator
 from scipy.spatial import cKDTree
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
@@ -90,7 +96,6 @@ class RegionNode(_Model):
     room_label: str | None = Field(default=None, description="Room type given later by the LLM, e.g. 'kitchen'.")
     centroid: Vec2 = Field(description="Mean position of its Voronoi nodes, metres.")
     nav_nodes: list[int] = Field(description="Indices of its nodes in SceneGraph.nav.")
-    object_ids: list[str] = Field(description="Objects assigned to it, sorted.")
     frontiers: list[Vec2] = Field(description="Frontier points (unexplored areas) attached to it, metres.")
 
 
@@ -103,11 +108,10 @@ class Relation(_Model):
 
 
 class RobotNode(_Model):
-    """The robot's state as the scene graph sees it."""
+    """The robot's pose as the scene graph sees it (what it holds: ``SceneGraph.held_object``)."""
 
     position: Vec2 = Field(description="(x, y) in metres.")
     region_id: str | None = Field(description="Region of the Voronoi node closest to the robot.")
-    held_object: str | None = Field(default=None, description="Id of the object in hand, if any.")
 
 
 class NavGraphData(_Model):
@@ -134,7 +138,7 @@ class SceneGraph(_Model):
 
     schema_version: int = Field(default=SCHEMA_VERSION, description="JSON schema version.")
     step: int = Field(description="Index of the build that produced it (0-based).")
-    robot: RobotNode = Field(description="Robot pose, region and held object.")
+    robot: RobotNode = Field(description="Robot pose and region.")
     regions: dict[str, RegionNode] = Field(description="Regions by id, reachable from the robot.")
     objects: dict[str, ObjectNode] = Field(description="Objects by id (in reachable regions, or held).")
     relations: list[Relation] = Field(description="Spatial relations between objects.")
@@ -150,9 +154,22 @@ class SceneGraph(_Model):
             self._tree = cKDTree(self.nav.node_xy)
         return int(self._tree.query(np.asarray(xy, dtype=float))[1])
 
+    @model_validator(mode="after")
+    def _check_hierarchy(self) -> SceneGraph:
+        held = [o.id for o in self.objects.values() if o.held]
+        if len(held) > 1:
+            raise ValueError(f"the robot holds one object at most, not {held}")
+        for o in self.objects.values():
+            if o.held != (o.region_id is None) or not (o.held or o.region_id in self.regions):
+                raise ValueError(f"object {o.id!r}: held={o.held} with region {o.region_id!r}; a held object has "
+                                 "no region, any other one a region of the graph")
+        return self
+
     def objects_in(self, region_id: str) -> list[ObjectNode]:
-        """Objects of one region, by id."""
-        return [self.objects[o] for o in self.regions[region_id].object_ids]
+        """Objects of one region, sorted by id (unknown region ids raise KeyError)."""
+        if region_id not in self.regions:
+            raise KeyError(region_id)
+        return sorted((o for o in self.objects.values() if o.region_id == region_id), key=lambda o: o.id)
 
     def frontiers(self, region_id: str) -> list[Vec2]:
         """Frontier points of one region (for explore(room))."""
@@ -160,7 +177,8 @@ class SceneGraph(_Model):
 
     @property
     def held_object(self) -> ObjectNode | None:
-        return None if self.robot.held_object is None else self.objects[self.robot.held_object]
+        """The object in the robot's hand, if any."""
+        return next((o for o in self.objects.values() if o.held), None)
 
     def with_room_labels(self, labels: dict[str, str]) -> SceneGraph:
         """A copy with LLM room labels set on the given regions (unknown ids raise KeyError)."""

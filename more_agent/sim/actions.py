@@ -25,6 +25,7 @@ from enum import Enum
 import numpy as np
 
 from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
+from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
 REACH_M = 1.5
@@ -71,12 +72,9 @@ class FailureReason(str, Enum):
 
 
 @dataclass(frozen=True)
-class ActionResult:
+class ActionResult(Outcome[FailureReason]):
     """The outcome of one action: success, typed reason and feedback, and the motion it took."""
 
-    ok: bool
-    reason: FailureReason | None
-    feedback: str
     low_level_steps: int = 0
     path: list[XY] = field(default_factory=list)
     """Robot base positions visited, start and end included, when the robot moved."""

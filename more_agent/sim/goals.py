@@ -19,6 +19,7 @@ from bddl.condition_evaluation import evaluate_state
 from more_agent.errors import UserError
 from more_agent.records import GoalCondition
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
+from more_agent.sim.predicates import holds
 from more_agent.sim.world import World
 
 if TYPE_CHECKING:
@@ -38,6 +39,10 @@ class Literal:
         """BDDL form with world names, e.g. '(inside apple_1 fridge_0)' or '(not (open fridge_0))'."""
         atom = f"({' '.join((self.predicate, *self.args))})"
         return f"(not {atom})" if self.negated else atom
+
+    def holds(self, world: World) -> bool:
+        """Whether the literal holds in ``world``: the predicates bddl evaluates (``sim.predicates``)."""
+        return holds(world, self.predicate, self.args) != self.negated
 
 
 @dataclass(frozen=True)
@@ -119,8 +124,3 @@ class GoalChecker:
             conditions=conditions,
             option_index=best_index,
         )
-
-    @property
-    def unsupported_predicates(self) -> set[str]:
-        """Goal predicates the backend cannot evaluate (they always read False), seen so far."""
-        return set(self.backend.unsupported)

@@ -37,10 +37,11 @@ from bddl.condition_evaluation import compile_state
 
 from more_agent.errors import UserError
 from more_agent.sim import catalog
-from more_agent.sim.bddl_backend import ROBOT_NAME, SUPPORTED_PREDICATES, ScopeObject, WorldBackend
+from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.matching import maximum_matching
+from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
 from more_agent.sim.scene import Scene
 from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
 from more_agent.sim.tasks import (
@@ -323,7 +324,7 @@ class _Builder:
                 if pred == "ontop":
                     self.agent_floor = self.scope.get(args[1])
                 continue
-            if pred not in SUPPORTED_PREDICATES or any(a in self.virtual for a in args):
+            if pred not in PREDICATES or any(a in self.virtual for a in args):
                 self.unsupported.append(literal_text(lit))
             elif pred == "open":
                 states.append(lit)

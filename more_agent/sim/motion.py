@@ -20,6 +20,7 @@ import numpy as np
 
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
 from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
+from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World
 
 
@@ -35,12 +36,9 @@ class MotionFailure(str, Enum):
 
 
 @dataclass(frozen=True)
-class MotionResult:
+class MotionResult(Outcome[MotionFailure]):
     """Outcome of one low-level move: success, reason and feedback, and the amount actually applied."""
 
-    ok: bool
-    reason: MotionFailure | None
-    feedback: str
     applied: float
     """Metres moved or radians turned (0 when the move failed); differs from the request when clipped."""
     low_level_steps: int = 1

@@ -12,7 +12,7 @@ import json
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from more_agent.errors import UserError
 
@@ -38,6 +38,16 @@ Metres = Annotated[float, Field(ge=-MAX_COORD_M, le=MAX_COORD_M)]
 Bounds2D = tuple[Metres, Metres, Metres, Metres]
 """(xmin, ymin, xmax, ymax) in metres."""
 
+
+def _ordered(b: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    if not (b[0] < b[2] and b[1] < b[3]):
+        raise ValueError(f"bounds must satisfy xmin < xmax and ymin < ymax, got {list(b)}")
+    return b
+
+
+Footprint = Annotated[Bounds2D, AfterValidator(_ordered)]
+"""Bounds2D of a non-empty rectangle: xmin < xmax and ymin < ymax."""
+
 Vec3 = tuple[Metres, Metres, Metres]
 
 
@@ -49,36 +59,25 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
-def _check_bounds(b: Bounds2D, what: str) -> None:
-    if not (b[0] < b[2] and b[1] < b[3]):
-        raise ValueError(f"{what} bounds must satisfy xmin < xmax and ymin < ymax, got {list(b)}")
-
-
 class Room(_Strict):
     """A room or outdoor region; its footprint is an axis-aligned rectangle."""
 
     id: str = Field(description="BEHAVIOR room instance name, e.g. 'kitchen_0'.")
     type: str = Field(description="BEHAVIOR room type, e.g. 'kitchen', 'garden'.")
-    bounds: Bounds2D = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres.")
+    bounds: Footprint = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres.")
     ground: GroundClass = Field(default="floor", description="Ground class of the footprint.")
     outdoor: bool = Field(default=False, description="True for gardens, driveways and other open-air regions.")
-
-    @model_validator(mode="after")
-    def _valid_bounds(self) -> Room:
-        _check_bounds(self.bounds, "room")
-        return self
 
 
 class Wall(_Strict):
     """A solid axis-aligned wall box from z_min to z_max (window openings split walls vertically)."""
 
-    bounds: Bounds2D = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres.")
+    bounds: Footprint = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres.")
     z_min: Metres = Field(default=0.0, description="Bottom of the box in metres.")
     z_max: Metres = Field(default=2.6, description="Top of the box in metres.")
 
     @model_validator(mode="after")
     def _valid(self) -> Wall:
-        _check_bounds(self.bounds, "wall")
         if self.z_max <= self.z_min:
             raise ValueError(f"wall z_max must exceed z_min, got {self.z_min}..{self.z_max}")
         return self
@@ -127,13 +126,8 @@ class GroundPatch(_Strict):
     """A rectangle of another ground class inside a room: a carpet under a rug, a garden's driveway."""
 
     room: str = Field(description="Id of the room it lies in.")
-    bounds: Bounds2D = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres, within the room.")
+    bounds: Footprint = Field(description="Footprint (xmin, ymin, xmax, ymax) in metres, within the room.")
     ground: GroundClass = Field(description="Ground class of the patch; it overrides the room's ground.")
-
-    @model_validator(mode="after")
-    def _valid_bounds(self) -> GroundPatch:
-        _check_bounds(self.bounds, "ground patch")
-        return self
 
 
 class Furniture(_Strict):
@@ -164,7 +158,7 @@ class Scene(_Strict):
     schema_version: Literal[1] = Field(default=SCENE_SCHEMA_VERSION, description="Scene format version.")
     name: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(default=0, description="Seed the plan was generated with (0 for hand-written scenes).")
-    bounds: Bounds2D = Field(description="Extent of the plan (xmin, ymin, xmax, ymax) in metres.")
+    bounds: Footprint = Field(description="Extent of the plan (xmin, ymin, xmax, ymax) in metres.")
     wall_height: float = Field(default=2.6, gt=0, le=MAX_COORD_M)
     rooms: list[Room] = Field(min_length=1)
     walls: list[Wall] = Field(default_factory=list)
@@ -175,7 +169,6 @@ class Scene(_Strict):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scene:
-        _check_bounds(self.bounds, "scene")
         extent = max(self.bounds[2] - self.bounds[0], self.bounds[3] - self.bounds[1])
         if extent > MAX_SCENE_EXTENT_M:
             raise ValueError(f"scene bounds span {extent:g} m, over the limit of {MAX_SCENE_EXTENT_M:g} m")

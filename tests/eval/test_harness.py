@@ -16,7 +16,7 @@ import pytest
 from more_agent.errors import UserError
 from more_agent.eval.harness import config_specs, evaluate, resolve_tasks
 from more_agent.eval.store import RunConfig, read_records
-from more_agent.eval.worker import episode_fn_path, resolve_episode_fn
+from more_agent.eval.worker import resolve_episode_fn
 from more_agent.records import EpisodeRecord
 from tests.eval import fake_episodes
 
@@ -51,15 +51,12 @@ def test_resolve_tasks_names_files_and_sets(tmp_path: Path) -> None:
         resolve_tasks(" , ")
 
 
-def test_specs_and_episode_fn_paths() -> None:
+def test_specs_and_episode_fn_resolution() -> None:
     specs = config_specs(config("deterministic_episode", ["a", "b"], seeds=2))
     assert [(s.task, s.seed) for s in specs] == [("a", 0), ("a", 1), ("b", 0), ("b", 1)]
-    assert episode_fn_path(fake_episodes.slow_episode) == f"{FAKE}:slow_episode"
     assert resolve_episode_fn(f"{FAKE}.slow_episode") is fake_episodes.slow_episode
     with pytest.raises(UserError, match="cannot import"):
         resolve_episode_fn("no_such_module:fn")
-    with pytest.raises(UserError, match="top-level"):
-        episode_fn_path(lambda spec: spec)
 
 
 def test_raising_episode_is_recorded_and_run_finishes(tmp_path: Path) -> None:

@@ -34,19 +34,16 @@ def hand_made_graph() -> SceneGraph:
         _obj("door A", "region_2", (4.0, 2.0), open_=True), _obj("sofa A", "region_2", (6.0, 2.0)),
         _obj("book A", None, (1.5, 1.5), held=True),
     ]
-    by_region: dict[str | None, list[str]] = {}
-    for o in objects:
-        by_region.setdefault(o.region_id, []).append(o.id)
     regions = {
         "region_0": RegionNode(id="region_0", room_label="kitchen", centroid=(2.0, 1.0), nav_nodes=[0],
-                               object_ids=sorted(by_region["region_0"]), frontiers=[(0.5, 3.0)]),
+                               frontiers=[(0.5, 3.0)]),
         "region_2": RegionNode(id="region_2", room_label="living room", centroid=(6.0, 2.0), nav_nodes=[1],
-                               object_ids=sorted(by_region["region_2"]), frontiers=[]),
-        "region_10": RegionNode(id="region_10", room_label=None, centroid=(9.0, 2.0), nav_nodes=[2], object_ids=[],
+                               frontiers=[]),
+        "region_10": RegionNode(id="region_10", room_label=None, centroid=(9.0, 2.0), nav_nodes=[2],
                                 frontiers=[(9.5, 3.0)]),
     }
     return SceneGraph(
-        step=3, robot=RobotNode(position=(1.5, 1.5), region_id="region_0", held_object="book A"),
+        step=3, robot=RobotNode(position=(1.5, 1.5), region_id="region_0"),
         regions=regions, objects={o.id: o for o in objects},
         relations=[Relation(subject="apple A", predicate="inside", object="fridge A"),
                    Relation(subject="apple B", predicate="ontop", object="table A")],
@@ -114,3 +111,18 @@ def test_empty_graph_text() -> None:
     })
     view = scene_view(graph, LanguageOptions())
     assert view.text() == "nothing observed yet" and view.robot_room == "unknown"
+
+
+def test_graph_stores_region_and_hand_once_and_rejects_contradictions() -> None:
+    graph = hand_made_graph()
+    assert [o.id for o in graph.objects_in("region_0")] == sorted(
+        o.id for o in graph.objects.values() if o.region_id == "region_0")
+    assert graph.objects_in("region_10") == [] and graph.held_object is not None and graph.held_object.id == "book A"
+    data = graph.model_dump()
+    for label, region, held, problem in [("apple A", None, False, "held=False with region None"),
+                                         ("sofa A", "region_7", False, "held=False with region 'region_7'"),
+                                         ("sofa A", "region_2", True, "holds one object at most")]:
+        data = graph.model_dump()
+        data["objects"][label].update(region_id=region, held=held)
+        with pytest.raises(ValueError, match=problem):
+            SceneGraph.model_validate(data)

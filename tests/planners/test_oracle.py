@@ -3,43 +3,55 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
+
+from bddl.activity import Conditions
 
 from more_agent.planners.base import EpisodeContext, make_planner
-from more_agent.planners.oracle import ORACLE_PREDICATES, OraclePlanner, literal_holds, merge_placements, order_literals
-from more_agent.records import GoalCondition
-from more_agent.sim.goals import GoalStatus, Literal
+from more_agent.planners.oracle import OraclePlanner, merge_placements, order_literals
+from more_agent.sim.bddl_backend import ScopeObject
+from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.world import World
 from tests.sim.test_navgrid import two_room_world
 
+SCOPES = {
+    "apple_0": "apple.n.01_1", "bowl_0": "bowl.n.01_1", "box_0": "carton.n.02_1",
+    "fridge_0": "electric_refrigerator.n.01_1", "cabinet_0": "cabinet.n.01_1", "table_0": "table.n.02_1",
+    "door_0": "door.n.01_1", "floor_kitchen_0": "floor.n.01_1", "floor_living_room_0": "floor.n.01_2",
+    ROBOT_NAME: "agent.n.01_1",
+}
+"""The bddl scope each object of ``two_room_world`` stands for."""
+
 
 @dataclass
-class FakeInstance:
+class GoalInstance:
+    """What ``GoalChecker`` reads of a task instance: a hand-built world and a BDDL goal over its scopes."""
+
     world: World
+    definition: SimpleNamespace
+    task: str = "oracle_test"
+
+    def scope_objects(self) -> dict[str, ScopeObject]:
+        return {s: ScopeObject(s, name, "agent" if name == ROBOT_NAME else "object") for name, s in SCOPES.items()}
 
 
-class FakeGoals:
-    """A GoalChecker stand-in: one option per list of literals, evaluated with the oracle's semantics."""
+def bddl_goals(world: World, goal: list[Literal]) -> GoalChecker:
+    """The real goal checker (bddl's evaluation through our backend) of the conjunction ``goal``."""
+    def atom(lit: Literal) -> str:
+        text = f"({' '.join((lit.predicate, *(SCOPES[a] for a in lit.args)))})"
+        return f"(not {text})" if lit.negated else text
 
-    def __init__(self, *options: list[Literal]) -> None:
-        self.options = [list(o) for o in options]
-
-    @property
-    def n_options(self) -> int:
-        return len(self.options)
-
-    def ground_literals(self, option_index: int) -> list[Literal]:
-        return list(self.options[option_index])
-
-    def check(self, world: World) -> GoalStatus:
-        sats = [[lit.predicate in ORACLE_PREDICATES and literal_holds(world, lit) for lit in opt] for opt in self.options]
-        best = max(range(len(sats)), key=lambda i: sum(sats[i]) / len(sats[i]))
-        conds = [GoalCondition(text=lit.text, satisfied=s) for lit, s in zip(self.options[best], sats[best])]
-        return GoalStatus(all(sats[best]), sum(sats[best]) / len(sats[best]), conds, best)
+    objects = " ".join(f"{s} - {s.rsplit('_', 1)[0]}" for s in SCOPES.values())
+    problem = (f"(define (problem oracle_test-0) (:domain omnigibson) (:objects {objects}) (:init) "
+               f"(:goal (and {' '.join(atom(lit) for lit in goal)})))")
+    conditions = Conditions("oracle_test", 0, "omnigibson", predefined_problem=problem)
+    return GoalChecker(GoalInstance(world, SimpleNamespace(conditions=conditions)))  # type: ignore[arg-type]
 
 
-def solve(world: World, goals: FakeGoals, max_steps: int = 50) -> tuple[list[tuple[str, tuple[str, ...], bool]], str]:
+def solve(world: World, goals: GoalChecker, max_steps: int = 50) -> tuple[list[tuple[str, tuple[str, ...], bool]], str]:
     planner = OraclePlanner()
-    planner.reset(EpisodeContext(instance=FakeInstance(world), goals=goals))  # type: ignore[arg-type]
+    planner.reset(EpisodeContext(instance=SimpleNamespace(world=world), goals=goals))  # type: ignore[arg-type]
     log = []
     for _ in range(max_steps):
         planner.observe()
@@ -64,7 +76,7 @@ def test_registry_builds_oracle():
 
 def test_opens_containers_then_moves_items():
     world = two_room_world()
-    goals = FakeGoals([inside("apple_0", "cabinet_0"), ontop("bowl_0", "floor_kitchen_0")])
+    goals = bddl_goals(world, [inside("apple_0", "cabinet_0"), ontop("bowl_0", "floor_kitchen_0")])
     log, note = solve(world, goals)
     assert goals.check(world).all_met and note == "all goal conditions hold"
     names = [(n, a[0]) for n, a, _ in log]
@@ -76,7 +88,7 @@ def test_opens_containers_then_moves_items():
 
 def test_closed_door_gets_opened():
     world = two_room_world(door_open=False)
-    goals = FakeGoals([ontop("box_0", "table_0")])
+    goals = bddl_goals(world, [ontop("box_0", "table_0")])
     log, _ = solve(world, goals)
     assert goals.check(world).all_met
     assert ("go_to_and_open", ("door_0",), True) in log
@@ -85,7 +97,7 @@ def test_closed_door_gets_opened():
 
 def test_not_open_goal_closes_at_the_end_and_contents_go_in_before_the_container_moves():
     world = two_room_world()
-    goals = FakeGoals([inside("box_0", "fridge_0"), inside("bowl_0", "box_0"), Literal("open", ("fridge_0",), True)])
+    goals = bddl_goals(world, [inside("box_0", "fridge_0"), inside("bowl_0", "box_0"), Literal("open", ("fridge_0",), True)])
     log, _ = solve(world, goals)
     assert goals.check(world).all_met
     assert log[-1][:2] == ("go_to_and_close", ("fridge_0",))
@@ -95,7 +107,7 @@ def test_not_open_goal_closes_at_the_end_and_contents_go_in_before_the_container
 
 def test_removal_goal_puts_item_elsewhere():
     world = two_room_world()
-    goals = FakeGoals([ontop("box_0", "floor_kitchen_0", negated=True)])
+    goals = bddl_goals(world, [ontop("box_0", "floor_kitchen_0", negated=True)])
     log, _ = solve(world, goals)
     assert goals.check(world).all_met and world.get("box_0").parent != "floor_kitchen_0"
     assert log[0][:2] == ("go_to_and_grasp", ("box_0",))
@@ -103,9 +115,10 @@ def test_removal_goal_puts_item_elsewhere():
 
 def test_unsupported_literal_is_explained():
     world = two_room_world()
-    goals = FakeGoals([Literal("cooked", ("apple_0",)), ontop("box_0", "table_0")])
+    goals = bddl_goals(world, [Literal("cooked", ("apple_0",)), ontop("box_0", "table_0")])
     log, note = solve(world, goals)
-    assert literal_holds(world, ontop("box_0", "table_0"))
+    status = goals.check(world)
+    assert {c.text: c.satisfied for c in status.conditions} == {"(cooked apple_0)": False, "(ontop box_0 table_0)": True}
     assert "cooked" in note and "not a rearrangement" in note
 
 
@@ -113,7 +126,7 @@ def test_gives_up_with_reason_when_stuck():
     world = two_room_world()
     world.set_robot_pose(2.5, 1.0, 0.0)
     world.get("table_0").center[:2] = (20.0, 20.0)  # the table is now outside every room: unreachable
-    goals = FakeGoals([ontop("box_0", "table_0")])
+    goals = bddl_goals(world, [ontop("box_0", "table_0")])
     log, note = solve(world, goals)
     assert note.startswith("oracle gave up") and "cannot reach table A" in note
 

@@ -77,7 +77,7 @@ def test_go_to_and_feedback_for_failed_preconditions() -> None:
     closed = go_to_and(body, graph, "place_inside", cabinet)
     assert not closed.ok and closed.feedback == "must open bottom_cabinet A first"
     graph = body.build()
-    assert graph.robot.held_object == "bottle_of_cooking_oil A" and graph.objects["bottle_of_cooking_oil A"].held
+    assert graph.held_object is not None and graph.held_object.id == "bottle_of_cooking_oil A"
 
 
 def test_explore_reaches_a_frontier_then_reports_none_left() -> None:

@@ -76,7 +76,7 @@ def test_forpairs() -> None:
 def test_ontop_follows_stacks_but_not_containers() -> None:
     inst = _inst("putting_shopping_away")
     world = inst.world
-    from more_agent.sim.bddl_backend import is_ontop
+    from more_agent.sim.predicates import is_ontop
 
     world.place("sack_1", "breakfast_table_0", "ontop")
     world.place("canned_food_1", "sack_1", "ontop")
@@ -87,7 +87,7 @@ def test_ontop_follows_stacks_but_not_containers() -> None:
 
 
 def test_furniture_stands_on_its_own_rooms_floor_only() -> None:
-    from more_agent.sim.bddl_backend import is_ontop
+    from more_agent.sim.predicates import is_ontop
 
     world = _inst("putting_shopping_away").world
     table = world.get("breakfast_table_0")

@@ -1,4 +1,4 @@
-"""Regenerate ``more_agent/data/task_data.json``: ``python -m more_agent.sim.build_task_data [--out PATH]``.
+"""Regenerate ``more_agent/data/task_data.json``: ``python scripts/build_task_data.py [--out PATH]``.
 
 For every bddl activity: the suitable scenes (``tasks.compute_suitable_scenes``), object and goal
 literal counts, whether the goal is pure rearrangement, and whether it instantiates in its first
