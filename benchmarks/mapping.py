@@ -30,11 +30,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / ".." / "shared" / "benchmarks"))
 from synth_apartment import make_apartment  # noqa: E402
 
-from more_agent.mapping import OCCUPIED, MappingConfig, VoxelMap, assign_objects, region_graph  # noqa: E402
+from more_agent.mapping import OCCUPIED, Grid, MappingConfig, VoxelMap, assign_objects, region_graph  # noqa: E402
 
 SIZES = (200, 400, 600, 1200, 2000)
 CFG = MappingConfig()
 RES = CFG.resolution_m
+GRID = Grid(resolution_m=RES)
 
 
 def _door_points(occ: np.ndarray, door: tuple[int, int], width: int = 12, wall: int = 2) -> np.ndarray:
@@ -45,17 +46,17 @@ def _door_points(occ: np.ndarray, door: tuple[int, int], width: int = 12, wall: 
     n = np.linspace(-wall / 2, wall / 2, 3)
     a, b = np.meshgrid(t, n)
     cells = np.stack([r + b.ravel(), c + a.ravel()], 1) if along_cols else np.stack([r + a.ravel(), c + b.ravel()], 1)
-    return (cells + 0.5) * RES
+    return GRID.xy_of(cells)
 
 
 def build_graph(occ, doors, objects, rooms) -> tuple[dict, dict]:
     """The whole graph pipeline (``region_graph``) on one map; returns (seconds per stage, counts)."""
-    obj_xy = (np.array([(o[0], o[1]) for o in objects]) + 0.5) * RES
+    obj_xy = GRID.xy_of(np.array([(o[0], o[1]) for o in objects]))
     room_centres = np.array([((a0 + a1) / 2, (b0 + b1) / 2) for a0, a1, b0, b1 in rooms]) * RES
     vp = room_centres[[o[2] for o in objects]]
-    out = region_graph(occ, door_points=[_door_points(occ, d) for d in doors], objects_xy=obj_xy, viewpoints_xy=vp,
-                       blocked=occ == OCCUPIED, config=CFG)
-    truth = assign_objects(out.graph, out.labels, vp, vp, cut=out.cut, resolution_m=RES)
+    out = region_graph(occ, GRID, door_points=[_door_points(occ, d) for d in doors], objects_xy=obj_xy,
+                       viewpoints_xy=vp, blocked=occ == OCCUPIED, config=CFG)
+    truth = assign_objects(out.graph, out.labels, vp, vp, cut=out.cut)
     counts = {
         "nodes_dense": out.dense.n_nodes, "edges_dense": out.dense.n_edges,
         "nodes_sparse": out.graph.n_nodes, "edges_sparse": out.graph.n_edges,
@@ -150,7 +151,7 @@ def run_scene(name: str, items: bool = True) -> dict:
         for i in range(nx):
             for j in range(ny):
                 x, y = x0 + (i + 0.5) * (x1 - x0) / nx, y0 + (j + 0.5) * (y1 - y0) / ny
-                world.set_robot_pose(*grid.to_xy(*grid.snap(x, y)), 0.0)
+                world.set_robot_pose(*grid.centre(grid.snap(x, y)), 0.0)
                 body.look_around()
     body.build()  # warm-up
     builds, cpu = [], []

@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 from more_agent.errors import UserError  # noqa: E402
 from more_agent.sim.clutter import add_distractors, clutter_rng  # noqa: E402
-from more_agent.sim.navgrid import nav_grid  # noqa: E402
+from more_agent.sim.navgrid import free_cells, nav_grid  # noqa: E402
 from more_agent.sim.render import Renderer  # noqa: E402
 from more_agent.sim.scenes import get_scene, scene_names  # noqa: E402
 from more_agent.sim.world import World  # noqa: E402
@@ -38,9 +38,9 @@ def time_scene(
     world = World.from_scene(get_scene(name, 0))
     n_items = len(add_distractors(world, clutter_rng(name, 0)).items) if items else 0
     grid = nav_grid(world)
-    rows, cols = np.nonzero(grid.free)
-    picks = rng.integers(len(rows), size=frames)
-    poses = [(*grid.to_xy(int(rows[k]), int(cols[k])), float(rng.uniform(-np.pi, np.pi))) for k in picks]
+    cells = free_cells(grid.free)
+    picks = rng.integers(len(cells), size=frames)
+    poses = [(*grid.centre(cells[k]), float(rng.uniform(-np.pi, np.pi))) for k in picks]
     geometry = renderer.geometry(world)
     times, cpu = [], []
     for x, y, yaw in poses:

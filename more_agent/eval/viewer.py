@@ -29,6 +29,7 @@ from PIL import Image
 from more_agent.errors import UserError
 from more_agent.eval.episode import EPISODE_FILE, run_episode
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.sim.grid import Grid
 
 log = logging.getLogger(__name__)
 
@@ -80,7 +81,7 @@ def _occupancy_uri(path: Path) -> tuple[str, list[float]] | None:
         width, height = im.size  # the file's rows run along y from the lowest
         picture = im.transpose(Image.Transpose.FLIP_TOP_BOTTOM)
     picture.putpalette(_OCC_PALETTE)
-    extent = [origin[0], origin[1], origin[0] + width * res, origin[1] + height * res]
+    extent = Grid(origin_xy=tuple(origin), resolution_m=res).bounds((width, height))
     buf = io.BytesIO()
     picture.save(buf, format="PNG", transparency=0)
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), [round(v, 3) for v in extent]

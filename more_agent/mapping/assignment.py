@@ -16,19 +16,45 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from more_agent.mapping.graph import NavGraph
+from more_agent.sim.grid import Grid
 
 
-def line_of_sight(
-    p: np.ndarray, targets: np.ndarray, blocked: np.ndarray, *, origin_xy: np.ndarray, resolution_m: float
-) -> np.ndarray:
-    """Which targets (k, 2) see point p without crossing a ``blocked`` grid cell; a blocked run at
-    p itself (the object stands in a wall, or is a door) is skipped."""
-    res = resolution_m
+def line_of_sight(p: np.ndarray, targets: np.ndarray, blocked: np.ndarray, grid: Grid) -> np.ndarray:
+    """Which targets see point ``p`` without crossing a ``blocked`` cell.
+
+    The segments are sampled every half cell; a blocked run at ``p`` itself (the object stands in a
+    wall, or is a door) is skipped. Samples off the grid never block.
+
+    Parameters
+    ----------
+    p : ndarray, shape (2,)
+        The point, metres.
+    targets : ndarray, shape (k, 2)
+        The points it may see, metres.
+    blocked : ndarray of bool, shape (nx, ny)
+        Cells that break the line of sight (walls, windows, doors), ``[ix, iy]``.
+    grid : Grid
+        Where ``blocked`` lies.
+
+    Returns
+    -------
+    seen : ndarray of bool, shape (k,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import Grid, line_of_sight
+    >>> blocked = np.zeros((4, 4), dtype=bool)
+    >>> blocked[2, :] = True  # a wall at 1.0 <= x < 1.5
+    >>> line_of_sight(np.array([0.25, 0.25]), np.array([[0.25, 1.75], [1.75, 0.25]]), blocked,
+    ...               Grid(resolution_m=0.5))
+    array([ True, False])
+    """
     length = np.linalg.norm(targets - p, axis=1).max(initial=0.0)
-    n = max(2, int(np.ceil(length / (res / 2))) + 1)
+    n = max(2, int(np.ceil(length / (grid.resolution_m / 2))) + 1)
     s = np.linspace(0.0, 1.0, n)
     pts = p + s[None, :, None] * (targets - p)[:, None, :]
-    cells = np.floor((pts - origin_xy) / res).astype(int)
+    cells = grid.cell_of(pts)
     inside = (cells >= 0).all(-1) & (cells[..., 0] < blocked.shape[0]) & (cells[..., 1] < blocked.shape[1])
     cells = np.where(inside[..., None], cells, 0)
     hit = blocked[cells[..., 0], cells[..., 1]] & inside
@@ -44,32 +70,64 @@ def assign_objects(
     *,
     cut: np.ndarray | None = None,
     blocked: np.ndarray | None = None,
-    resolution_m: float = 0.075,
-    origin_xy: tuple[float, float] = (0.0, 0.0),
+    grid: Grid | None = None,
     lam: float = 1.3,
     radius_m: float = 2.5,
     k: int = 8,
 ) -> np.ndarray:
-    """Region label per object (n,), -1 when the graph has no labelled node.
+    """Region label per object by Eq. 1 (see the module docstring).
 
-    ``labels``: region per node (-1 = none); ``viewpoints_xy`` (n, 2): each object's closest
-    viewpoint; ``cut``: door-crossing edge mask excluded from d_V; ``blocked``: BEV grid of
-    structural cells for the line-of-sight test (omitted: no test).
+    Parameters
+    ----------
+    graph : NavGraph
+        The sparse Voronoi graph.
+    labels : ndarray of int, shape (n_nodes,)
+        Region per node, -1 for none.
+    objects_xy : ndarray, shape (n, 2)
+        Object positions, metres.
+    viewpoints_xy : ndarray, shape (n, 2)
+        Each object's closest viewpoint, metres.
+    cut : ndarray of bool, shape (n_edges,), optional
+        Door-crossing edges, left out of d_V.
+    blocked : ndarray of bool, shape (nx, ny), optional
+        Structural cells for the line-of-sight test (omitted: no test); needs ``grid``.
+    grid : Grid, optional
+        Where ``blocked`` lies.
+    lam : float, optional
+        The exponent lambda on d_E(O, v).
+    radius_m : float, optional
+        "Near": within this distance, or the closest node when none is.
+    k : int, optional
+        At most this many nearest nodes are considered near.
+
+    Returns
+    -------
+    regions : ndarray of int, shape (n,)
+        Region label per object, -1 when the graph has no labelled node.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import NavGraph, assign_objects
+    >>> two = NavGraph(np.array([[0.5, 0.5], [3.5, 0.5]]), np.zeros((0, 2), dtype=np.int64), np.zeros(0))
+    >>> assign_objects(two, np.array([0, 1]), np.array([[1.0, 0.5]]), np.array([[0.8, 0.5]]))
+    array([0])
     """
+    if blocked is not None and grid is None:
+        raise ValueError("assign_objects: 'blocked' needs the grid it lies on")
     out = np.full(len(objects_xy), -1, dtype=np.int64)
     cand = np.flatnonzero(labels >= 0)
     if cand.size == 0 or len(objects_xy) == 0:
         return out
     tree = cKDTree(graph.xy[cand])
     kk = min(k, cand.size)
-    origin = np.asarray(origin_xy, dtype=float)
     adjacency = graph.csr(None if cut is None else ~cut)
 
     def near(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         d, i = tree.query(p, k=kk)
         d, i = np.atleast_1d(d), np.atleast_1d(i)
         if blocked is not None:
-            seen = line_of_sight(p, graph.xy[cand[i]], blocked, origin_xy=origin, resolution_m=resolution_m)
+            seen = line_of_sight(p, graph.xy[cand[i]], blocked, grid)
             if seen.any():
                 d, i = d[seen], i[seen]
         within = d <= max(radius_m, d[0])

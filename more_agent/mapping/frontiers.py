@@ -6,20 +6,46 @@ import numpy as np
 from scipy import ndimage
 
 from more_agent.mapping.occupancy import FREE, UNKNOWN
+from more_agent.sim.grid import Grid
 
 
 def frontier_points(
     occupancy: np.ndarray,
+    grid: Grid,
     *,
-    resolution_m: float,
-    origin_xy: tuple[float, float] = (0.0, 0.0),
     min_length_m: float = 0.3,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Frontier points (k, 2) in metres and cluster lengths (k,) in metres (cells x resolution).
+    """Frontier points and cluster lengths of a BEV grid.
 
     A frontier cell is FREE with an UNKNOWN 4-neighbour (outside the grid counts as unknown);
     8-connected frontier cells form a cluster; clusters shorter than ``min_length_m`` are dropped;
     each cluster is represented by its cell closest to the cluster centroid.
+
+    Parameters
+    ----------
+    occupancy : ndarray of int, shape (nx, ny)
+        UNKNOWN / FREE / OCCUPIED per cell, ``[ix, iy]``.
+    grid : Grid
+        Where ``occupancy`` lies.
+    min_length_m : float, optional
+        Shortest cluster kept, as cells x resolution.
+
+    Returns
+    -------
+    points : ndarray, shape (k, 2)
+        One point per kept cluster, metres.
+    lengths : ndarray, shape (k,)
+        Cluster lengths (cells x resolution), metres.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import FREE, OCCUPIED, UNKNOWN, Grid, frontier_points
+    >>> occ = np.full((6, 5), OCCUPIED, dtype=np.int8)
+    >>> occ[1:5, 1:4] = FREE     # a room seen from inside ...
+    >>> occ[5, 1:4] = UNKNOWN    # ... whose east side is not seen yet
+    >>> frontier_points(occ, Grid(resolution_m=0.5), min_length_m=1.0)
+    (array([[2.25, 1.25]]), array([1.5]))
     """
     unknown = np.pad(occupancy == UNKNOWN, 1, constant_values=True)
     touches = unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2] | unknown[1:-1, 2:]
@@ -34,6 +60,5 @@ def frontier_points(
     d2 = ((cells - centroid[ids]) ** 2).sum(1)
     order = np.lexsort((d2, ids))
     first = order[np.searchsorted(ids[order], np.arange(n))]
-    keep = sizes * resolution_m >= min_length_m
-    pts = np.asarray(origin_xy) + (cells[first[keep]] + 0.5) * resolution_m
-    return pts, sizes[keep] * resolution_m
+    keep = sizes * grid.resolution_m >= min_length_m
+    return grid.xy_of(cells[first[keep]]), sizes[keep] * grid.resolution_m

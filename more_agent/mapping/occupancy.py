@@ -9,7 +9,8 @@ Voxels of free-space classes are never cleared by passing rays: grazing rays wou
 erase the ground they skim. (Rays grazing a table top on their way to the floor behind do erode
 some of its voxels; the holes are single cells, narrower than the inflation, so the graph is not
 affected.) Depth is z-depth in the OpenCV camera frame (x right, y down, z fwd).
-Grid layout: ``grid[ix, iy]``, cell centre ``origin_xy + (ix + 0.5, iy + 0.5) * resolution_m``.
+Grid layout: ``grid[ix, iy]`` on ``VoxelMap.grid`` (:class:`~more_agent.sim.grid.Grid`); the
+compiled kernels repeat ``Grid.cell_of`` inline, in z as well, on the voxel map's corner.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from collections.abc import Iterable
 import numba
 import numpy as np
 
+from more_agent.sim.grid import Grid
+
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 """BEV cell values (also used by the synthetic benchmark maps)."""
 
@@ -26,7 +29,32 @@ _MAX_CLASSES = 65535
 
 
 def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """World points (N, 3) of the finite depth pixels and their flat pixel indices (N,)."""
+    """World points of the finite depth pixels, and which pixels they are.
+
+    Parameters
+    ----------
+    depth : ndarray, shape (h, w)
+        Z-depth, metres; non-finite where nothing was hit.
+    K : ndarray, shape (3, 3)
+        Camera intrinsics (pixel centres at +0.5).
+    T_world_cam : ndarray, shape (4, 4)
+        Camera-to-world pose (OpenCV camera frame).
+
+    Returns
+    -------
+    points : ndarray, shape (N, 3)
+        World points, metres.
+    pixels : ndarray of int, shape (N,)
+        Flat index of each point's pixel.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import depth_to_points
+    >>> K = np.array([[1.0, 0.0, 1.0], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])
+    >>> depth_to_points(np.array([[2.0, np.inf]]), K, np.eye(4))
+    (array([[-1.,  0.,  2.]]), array([0]))
+    """
     h, w = depth.shape
     v, u = np.mgrid[0:h, 0:w]
     valid = np.isfinite(depth).ravel()
@@ -119,7 +147,8 @@ class VoxelMap:
         carve_stride_px: int = 2,
         initial_extent_m: float = 20.0,
     ) -> None:
-        self.resolution_m = resolution_m
+        self.grid = Grid(resolution_m=resolution_m)
+        """Where the voxel columns and the BEV lie; the corner moves when the map grows."""
         self.max_range_m = max_range_m
         self.carve_stride_px = carve_stride_px
         self.initial_extent_m = initial_extent_m
@@ -128,7 +157,6 @@ class VoxelMap:
         self._nz = int(np.ceil((z_max_m - z_min_m) / resolution_m))
         self._z_min = z_min_m
         self._top_level = min(self._nz - 1, int(np.ceil((bev_max_height_m - z_min_m) / resolution_m - 0.5)) - 1)
-        self.origin_xy = np.zeros(2)
         self.cls = np.zeros((0, 0, self._nz), dtype=np.uint16)
         self.inst = np.zeros((0, 0, self._nz), dtype=np.int32)
         self.top_class = np.full((0, 0), -1, dtype=np.int32)
@@ -140,19 +168,18 @@ class VoxelMap:
 
     def _ensure_covers(self, lo: np.ndarray, hi: np.ndarray) -> None:
         """Grow the grid (whole cells, existing content kept) so that [lo, hi] in xy lies inside."""
-        res = self.resolution_m
+        res = self.grid.resolution_m
         if self.cls.shape[0] == 0:
             half = max(self.initial_extent_m / 2, float(np.max(hi - lo)) / 2 + res)
             centre = (lo + hi) / 2
-            self.origin_xy = np.round((centre - half) / res) * res
+            self._move_corner(np.round((centre - half) / res) * res)
             n = int(np.ceil(2 * half / res))
             self.cls = np.zeros((n, n, self._nz), dtype=np.uint16)
             self.inst = np.zeros((n, n, self._nz), dtype=np.int32)
             self.top_class = np.full((n, n), -1, dtype=np.int32)
             return
         size = np.array(self.shape)
-        low = np.floor((lo - self.origin_xy) / res).astype(int)
-        high = np.ceil((hi - self.origin_xy) / res).astype(int)
+        low, high = self.grid.cell_range(lo, hi)
         if (low >= 0).all() and (high <= size).all():
             return
         margin = int(np.ceil(self.initial_extent_m / 2 / res))
@@ -162,7 +189,10 @@ class VoxelMap:
         self.cls = np.pad(self.cls, (*pads, (0, 0)))
         self.inst = np.pad(self.inst, (*pads, (0, 0)))
         self.top_class = np.pad(self.top_class, pads, constant_values=-1)
-        self.origin_xy = self.origin_xy - pad_lo * res
+        self._move_corner(np.asarray(self.grid.origin_xy) - pad_lo * res)
+
+    def _move_corner(self, origin_xy: np.ndarray) -> None:
+        self.grid = Grid(origin_xy=(float(origin_xy[0]), float(origin_xy[1])), resolution_m=self.grid.resolution_m)
 
     def integrate(
         self,
@@ -181,16 +211,16 @@ class VoxelMap:
         r = self.max_range_m
         self._ensure_covers(trans[:2] - r, trans[:2] + r)
         intr = np.array([K[0, 0], K[1, 1], K[0, 2], K[1, 2]], dtype=np.float64)
-        origin = np.array([self.origin_xy[0], self.origin_xy[1], self._z_min])
+        origin = np.array([*self.grid.origin_xy, self._z_min])
         depth = np.ascontiguousarray(depth, dtype=np.float32)
         ignore = np.fromiter(ignore_instances, dtype=np.int64)
         use = ~np.isin(instance, ignore) if ignore.size else np.ones(depth.shape, dtype=np.bool_)
-        res = self.resolution_m
+        res = self.grid.resolution_m
         _carve(depth, intr, rot, trans, self.cls, origin, res, r, self.carve_stride_px, self._free_lut)
         _insert(depth, semantic.astype(np.int32, copy=False), instance.astype(np.int32, copy=False), use,
                 intr, rot, trans, self.cls, self.inst, origin, res, r)
-        lo = np.maximum(np.floor((trans[:2] - r - self.origin_xy) / res).astype(int), 0)
-        hi = np.minimum(np.ceil((trans[:2] + r - self.origin_xy) / res).astype(int) + 1, self.shape)
+        lo, hi = self.grid.cell_range(trans[:2] - r, trans[:2] + r)
+        lo, hi = np.maximum(lo, 0), np.minimum(hi + 1, self.shape)  # one cell of margin
         _update_top(self.cls, self.top_class, lo[0], hi[0], lo[1], hi[1], self._top_level)
 
     def occupancy(self) -> np.ndarray:
@@ -211,10 +241,7 @@ class VoxelMap:
         ids = self.inst.ravel()[flat]
         order = np.argsort(ids, kind="stable")
         flat, ids = flat[order], ids[order]
-        ix, iy, iz = np.unravel_index(flat, self.inst.shape)
-        res = self.resolution_m
-        pts = np.stack([self.origin_xy[0] + (ix + 0.5) * res, self.origin_xy[1] + (iy + 0.5) * res,
-                        self._z_min + (iz + 0.5) * res], axis=1)
+        pts = self._centres(*np.unravel_index(flat, self.inst.shape))
         uniq, starts = np.unique(ids, return_index=True)
         return {int(i): p for i, p in zip(uniq, np.split(pts, starts[1:]))}
 
@@ -227,6 +254,9 @@ class VoxelMap:
         self.inst[hit] = 0
         if ix.size:
             _update_top(self.cls, self.top_class, ix.min(), ix.max() + 1, iy.min(), iy.max() + 1, self._top_level)
-        res = self.resolution_m
-        return np.stack([self.origin_xy[0] + (ix + 0.5) * res, self.origin_xy[1] + (iy + 0.5) * res,
-                         self._z_min + (iz + 0.5) * res], axis=1)
+        return self._centres(ix, iy, iz)
+
+    def _centres(self, ix: np.ndarray, iy: np.ndarray, iz: np.ndarray) -> np.ndarray:
+        """World coordinates (k, 3) of voxel centres."""
+        z = self._z_min + (iz + 0.5) * self.grid.resolution_m
+        return np.column_stack([self.grid.xy_of(np.stack([ix, iy], axis=1)), z])

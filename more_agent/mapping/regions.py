@@ -11,6 +11,7 @@ from scipy import ndimage
 
 from more_agent.mapping.graph import NavGraph
 from more_agent.mapping.occupancy import FREE
+from more_agent.sim.grid import Grid
 
 
 @dataclass(frozen=True)
@@ -25,8 +26,28 @@ class DoorKernel:
 
 
 def fit_door_kernel(points_xy: np.ndarray, *, min_sigma_m: float = 0.15) -> DoorKernel:
-    """Kernel from a door's observed points (k, 2): centre of the oriented bounding box, its
-    orientation (principal axis), and half its width / thickness as deviations (>= min_sigma_m)."""
+    """Kernel from a door's observed points: centre of the oriented bounding box, its orientation
+    (principal axis), and half its width / thickness as deviations.
+
+    Parameters
+    ----------
+    points_xy : ndarray, shape (k, 2)
+        The door's observed points, metres.
+    min_sigma_m : float, optional
+        Floor of both deviations.
+
+    Returns
+    -------
+    kernel : DoorKernel
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import fit_door_kernel
+    >>> door = fit_door_kernel(np.array([[1.0, 0.5], [1.0, 1.0], [1.0, 1.5]]))  # a 1 m door in a wall at x = 1
+    >>> door.center_xy, door.sigma_along_m, door.sigma_across_m
+    ((1.0, 1.0), 0.5, 0.15)
+    """
     mean = points_xy.mean(axis=0)
     if len(points_xy) > 1:
         evals, evecs = np.linalg.eigh(np.cov((points_xy - mean).T))
@@ -45,7 +66,27 @@ def fit_door_kernel(points_xy: np.ndarray, *, min_sigma_m: float = 0.15) -> Door
 
 
 def door_field(points_xy: np.ndarray, doors: list[DoorKernel]) -> np.ndarray:
-    """Sum of the door kernels evaluated at points (..., 2)."""
+    """Sum of the door kernels evaluated at points.
+
+    Parameters
+    ----------
+    points_xy : ndarray, shape (..., 2)
+        Points, metres.
+    doors : list of DoorKernel
+
+    Returns
+    -------
+    field : ndarray, shape (...)
+        Each kernel peaks at 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import door_field, fit_door_kernel
+    >>> door = fit_door_kernel(np.array([[1.0, 0.5], [1.0, 1.0], [1.0, 1.5]]))  # a 1 m door in a wall at x = 1
+    >>> door_field(np.array([[1.0, 1.0], [1.15, 1.0], [2.0, 1.0]]), [door]).round(3)
+    array([1.   , 0.607, 0.   ])
+    """
     out = np.zeros(points_xy.shape[:-1])
     for door in doors:
         d = points_xy - np.asarray(door.center_xy)
@@ -59,8 +100,32 @@ def door_field(points_xy: np.ndarray, doors: list[DoorKernel]) -> np.ndarray:
 def door_crossing_edges(
     graph: NavGraph, doors: list[DoorKernel], *, threshold_m: float = 0.15, step_m: float = 0.0375
 ) -> np.ndarray:
-    """Boolean mask (m,) of edges whose integral of the door field along the straight segment
-    exceeds ``threshold_m`` (a full crossing of a kernel integrates to sigma_across * sqrt(2 pi))."""
+    """Edges whose integral of the door field along the straight segment exceeds ``threshold_m``.
+
+    A full crossing of a kernel integrates to sigma_across * sqrt(2 pi).
+
+    Parameters
+    ----------
+    graph : NavGraph
+    doors : list of DoorKernel
+    threshold_m : float, optional
+        Integral (metres of kernel value 1) above which an edge is cut.
+    step_m : float, optional
+        Sampling step along an edge.
+
+    Returns
+    -------
+    cut : ndarray of bool, shape (n_edges,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import NavGraph, door_crossing_edges, fit_door_kernel
+    >>> door = fit_door_kernel(np.array([[1.0, 0.5], [1.0, 1.0], [1.0, 1.5]]))  # a 1 m door in a wall at x = 1
+    >>> g = NavGraph(np.array([[0.0, 1.0], [2.0, 1.0], [2.0, 2.0]]), np.array([[0, 1], [1, 2]]), np.array([2.0, 1.0]))
+    >>> door_crossing_edges(g, [door])  # the first edge walks through the door
+    array([ True, False])
+    """
     cut = np.zeros(graph.n_edges, dtype=bool)
     if not doors or graph.n_edges == 0:
         return cut
@@ -83,8 +148,31 @@ def door_crossing_edges(
 def segment_regions(
     graph: NavGraph, cut: np.ndarray, doors: list[DoorKernel], *, doorway_value: float = 0.05
 ) -> np.ndarray:
-    """Region label per node (0..k-1, ordered by each region's smallest (x, y) node), -1 for nodes
-    of components lying entirely in doorways (kernel value > ``doorway_value`` at every node)."""
+    """Region label per node: the components of the graph without its cut edges.
+
+    Parameters
+    ----------
+    graph : NavGraph
+    cut : ndarray of bool, shape (n_edges,)
+        Door-crossing edges.
+    doors : list of DoorKernel
+    doorway_value : float, optional
+        A component whose nodes all have a kernel value above this lies in a doorway.
+
+    Returns
+    -------
+    labels : ndarray of int, shape (n_nodes,)
+        0..k-1, ordered by each region's smallest (x, y) node; -1 for doorway components.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import NavGraph, door_crossing_edges, fit_door_kernel, segment_regions
+    >>> door = fit_door_kernel(np.array([[1.0, 0.5], [1.0, 1.0], [1.0, 1.5]]))  # a 1 m door in a wall at x = 1
+    >>> g = NavGraph(np.array([[0.0, 1.0], [2.0, 1.0], [2.0, 2.0]]), np.array([[0, 1], [1, 2]]), np.array([2.0, 1.0]))
+    >>> segment_regions(g, door_crossing_edges(g, [door]), [door])
+    array([0, 1, 1])
+    """
     comp = graph.components(~cut)
     if graph.n_nodes == 0:
         return comp
@@ -102,8 +190,36 @@ def merge_subregions(
     doorway: np.ndarray,
 ) -> np.ndarray:
     """Merge regions whose nodes fall in one 8-connected patch of FREE, non-``doorway`` cells
-    (sub-regions of one room split by partial observation or furniture). ``node_cells`` (n, 2)
-    are the nodes' grid indices; ``doorway`` is a boolean grid of door-kernel cells."""
+    (sub-regions of one room split by partial observation or furniture).
+
+    Parameters
+    ----------
+    labels : ndarray of int, shape (n,)
+        Region per node, -1 for none.
+    node_cells : ndarray of int, shape (n, 2)
+        The nodes' cells (ix, iy), as ``Grid.cell_of`` gives them.
+    occupancy : ndarray of int, shape (nx, ny)
+        The BEV grid.
+    doorway : ndarray of bool, shape (nx, ny)
+        Door-kernel cells (see ``doorway_mask``).
+
+    Returns
+    -------
+    labels : ndarray of int, shape (n,)
+        Merged labels, renumbered 0..k-1 in order; -1 kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import FREE, merge_subregions
+    >>> occ = np.full((4, 2), FREE, dtype=np.int8)
+    >>> doorway = np.zeros((4, 2), dtype=bool)
+    >>> merge_subregions(np.array([0, 1]), np.array([[0, 0], [3, 1]]), occ, doorway)
+    array([0, 0])
+    >>> doorway[2] = True  # a doorway splits the patch
+    >>> merge_subregions(np.array([0, 1]), np.array([[0, 0], [3, 1]]), occ, doorway)
+    array([0, 1])
+    """
     if labels.size == 0 or labels.max() < 0:
         return labels
     patches, _ = ndimage.label((occupancy == FREE) & ~doorway, structure=np.ones((3, 3)))
@@ -131,23 +247,46 @@ def merge_subregions(
 
 def doorway_mask(
     shape: tuple[int, int],
+    grid: Grid,
     doors: list[DoorKernel],
     *,
-    resolution_m: float,
-    origin_xy: tuple[float, float] = (0.0, 0.0),
     value: float = 0.05,
 ) -> np.ndarray:
-    """Boolean grid of the cells where a door kernel exceeds ``value``."""
+    """The cells where a door kernel exceeds ``value``.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        (nx, ny) of the grid.
+    grid : Grid
+        Where the cells lie.
+    doors : list of DoorKernel
+    value : float, optional
+        Kernel value above which a cell is in a doorway.
+
+    Returns
+    -------
+    mask : ndarray of bool, shape ``shape``
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import Grid, doorway_mask, fit_door_kernel
+    >>> door = fit_door_kernel(np.array([[1.0, 0.5], [1.0, 1.0], [1.0, 1.5]]))  # a 1 m door in a wall at x = 1
+    >>> doorway_mask((4, 4), Grid(resolution_m=0.5), [door]).astype(int)
+    array([[0, 0, 0, 0],
+           [1, 1, 1, 1],
+           [1, 1, 1, 1],
+           [0, 0, 0, 0]])
+    """
     mask = np.zeros(shape, dtype=bool)
     for door in doors:
         reach = max(door.sigma_along_m, door.sigma_across_m) * np.sqrt(2 * np.log(1 / value))
-        lo = np.floor((np.asarray(door.center_xy) - reach - origin_xy) / resolution_m).astype(int)
-        hi = np.ceil((np.asarray(door.center_xy) + reach - origin_xy) / resolution_m).astype(int) + 1
-        lo, hi = np.maximum(lo, 0), np.minimum(hi, shape)
+        lo, hi = grid.cell_range(np.asarray(door.center_xy) - reach, np.asarray(door.center_xy) + reach)
+        lo, hi = np.maximum(lo, 0), np.minimum(hi + 1, shape)  # one cell of margin
         if (hi <= lo).any():
             continue
-        ix, iy = np.mgrid[lo[0]:hi[0], lo[1]:hi[1]]
-        centres = np.stack([origin_xy[0] + (ix + 0.5) * resolution_m, origin_xy[1] + (iy + 0.5) * resolution_m], axis=-1)
+        centres = grid.xy_of(np.stack(np.mgrid[lo[0]:hi[0], lo[1]:hi[1]], axis=-1))
         mask[lo[0]:hi[0], lo[1]:hi[1]] |= door_field(centres, [door]) > value
     return mask
 

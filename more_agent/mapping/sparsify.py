@@ -44,7 +44,30 @@ def sparsify(graph: NavGraph, *, threshold_m: float) -> tuple[NavGraph, np.ndarr
     leaves a minimal graph: no remaining degree-2 node has two non-adjacent neighbours and an edge
     sum below the threshold. A node whose neighbours are already adjacent is kept, so the graph
     stays simple; shortest-path lengths and connectivity between kept nodes are unchanged.
-    Returns the sparse graph and the original indices of its nodes.
+
+    Parameters
+    ----------
+    graph : NavGraph
+        The dense graph.
+    threshold_m : float
+        A degree-2 node goes when its two edges sum below this.
+
+    Returns
+    -------
+    sparse : NavGraph
+        The kept nodes and the bridged edges.
+    kept : ndarray of int, shape (n_kept,)
+        Index in ``graph`` of each node of ``sparse``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import NavGraph, sparsify
+    >>> xy = np.array([[0.0, 0.0], [0.1, 0.0], [0.2, 0.0], [0.3, 0.0]])
+    >>> path = NavGraph(xy, np.array([[0, 1], [1, 2], [2, 3]]), np.full(3, 0.1))
+    >>> sparse, kept = sparsify(path, threshold_m=0.5)
+    >>> kept, sparse.edges, sparse.weights.round(3)
+    (array([0, 3]), array([[0, 1]]), array([0.3]))
     """
     n = graph.n_nodes
     if n == 0:

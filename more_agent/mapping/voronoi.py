@@ -1,7 +1,7 @@
 """Generalized Voronoi diagram of the free space of a BEV occupancy grid, as a ``NavGraph``.
 
-Grid convention used throughout ``mapping``: ``grid[ix, iy]`` is the cell whose centre lies at
-``origin_xy + (ix + 0.5, iy + 0.5) * resolution_m`` (x east, y north).
+Grid convention used throughout ``mapping``: ``occupancy[ix, iy]`` on a
+:class:`~more_agent.sim.grid.Grid` (x east, y north).
 
 The GVD is computed in time linear in the grid area: one Euclidean distance transform with
 feature indices (the ESDF), then a cell pair straddles the GVD when the nearest obstacle cells of
@@ -18,6 +18,7 @@ from scipy import ndimage
 
 from more_agent.mapping.graph import NavGraph
 from more_agent.mapping.occupancy import FREE
+from more_agent.sim.grid import Grid
 
 
 @numba.njit(cache=True)
@@ -121,18 +122,41 @@ def _pixel_graph(skel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def voronoi_graph(
     occupancy: np.ndarray,
+    grid: Grid,
     *,
-    resolution_m: float,
-    origin_xy: tuple[float, float] = (0.0, 0.0),
     inflation_m: float = 0.15,
     min_separation_m: float = 0.3,
 ) -> NavGraph:
     """Voronoi graph of the free cells (``occupancy == FREE``) of a BEV grid.
 
-    ``inflation_m``: cells closer than this to any non-free cell are excluded (ESDF inflation,
-    robot clearance). ``min_separation_m``: two neighbours straddle the GVD when their nearest
-    obstacles are farther apart than this; smaller values keep more wall-corner spurs.
-    Nodes are skeleton cell centres in world metres; edge weights are metric lengths.
+    Parameters
+    ----------
+    occupancy : ndarray of int, shape (nx, ny)
+        UNKNOWN / FREE / OCCUPIED per cell, ``[ix, iy]``; every non-free cell is an obstacle.
+    grid : Grid
+        Where ``occupancy`` lies.
+    inflation_m : float, optional
+        Cells closer than this to any non-free cell are excluded (ESDF inflation, robot clearance).
+    min_separation_m : float, optional
+        Two neighbours straddle the GVD when their nearest obstacles are farther apart than this;
+        smaller values keep more wall-corner spurs.
+
+    Returns
+    -------
+    graph : NavGraph
+        Nodes at skeleton cell centres (metres), 8-connected edges weighted by metric length.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from more_agent.mapping import FREE, Grid, voronoi_graph
+    >>> occ = np.zeros((12, 5), dtype=np.int8)
+    >>> occ[1:11, 1:4] = FREE  # a corridor three cells wide along x
+    >>> g = voronoi_graph(occ, Grid(resolution_m=0.1), inflation_m=0.05)
+    >>> g.xy.round(2).tolist()  # its centre line
+    [[0.35, 0.25], [0.45, 0.25], [0.55, 0.25], [0.65, 0.25], [0.75, 0.25], [0.85, 0.25]]
+    >>> g.weights.round(2)
+    array([0.1, 0.1, 0.1, 0.1, 0.1])
     """
     free = occupancy == FREE
     if not free.any():
@@ -143,13 +167,11 @@ def voronoi_graph(
     crop[1:-1, 1:-1] = free[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
     # feature indices only (int32): the distances follow from them without scipy's float temporaries
     feat_r, feat_c = ndimage.distance_transform_edt(crop, return_distances=False, return_indices=True)
-    domain = _clearance_mask(feat_r, feat_c, float(resolution_m), float(inflation_m))
-    band = _gvd_band(domain, feat_r, feat_c, (min_separation_m / resolution_m) ** 2)
+    res = grid.resolution_m
+    domain = _clearance_mask(feat_r, feat_c, float(res), float(inflation_m))
+    band = _gvd_band(domain, feat_r, feat_c, (min_separation_m / res) ** 2)
     if not band.any():
         return NavGraph.empty()
     skel = _thin(band)
     cells, edges, steps = _pixel_graph(skel)
-    xy = np.empty((len(cells), 2))
-    xy[:, 0] = origin_xy[0] + (cells[:, 0] + r0 + 0.5) * resolution_m
-    xy[:, 1] = origin_xy[1] + (cells[:, 1] + c0 + 0.5) * resolution_m
-    return NavGraph(xy, edges, steps * resolution_m)
+    return NavGraph(grid.xy_of(cells + (r0, c0)), edges, steps * res)

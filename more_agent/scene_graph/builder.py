@@ -36,6 +36,7 @@ from more_agent.scene_graph.model import (
     SceneGraph,
 )
 from more_agent.scene_graph.relations import spatial_relations
+from more_agent.sim.grid import Grid
 from more_agent.sim.scene import FREE_SPACE_CLASSES
 
 STRUCTURE_CATEGORIES = ("wall", "window", "door")
@@ -113,7 +114,7 @@ class SceneGraphBuilder:
     # ---------------------------------------------------------------- per step
     def build(self, robot_xy: Sequence[float]) -> SceneGraph:
         """The scene graph of everything observed so far, reduced to the robot's component."""
-        origin = tuple(self.voxels.origin_xy)
+        grid = self.voxels.grid
         robot = np.asarray(robot_xy[:2], dtype=float)
         occ = self.voxels.occupancy()
         blocked = np.isin(self.voxels.top_class, self._structure_ids)
@@ -125,12 +126,12 @@ class SceneGraphBuilder:
         objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
-        rg = region_graph(occ, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
-                          blocked=blocked, origin_xy=origin, config=self.config)
+        rg = region_graph(occ, grid, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
+                          blocked=blocked, config=self.config)
         region_ids = self._stable_ids(rg.graph, rg.labels)
-        keep = self._robot_component(rg.graph, robot, blocked, origin)
-        frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, origin)
-        return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, origin)
+        keep = self._robot_component(rg.graph, robot, blocked, grid)
+        frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
+        return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, grid)
 
     # ---------------------------------------------------------------- helpers
     def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
@@ -141,27 +142,26 @@ class SceneGraphBuilder:
         vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
         return xy if len(vps) == 0 else vps[np.argmin(np.linalg.norm(vps - xy, axis=1))]
 
-    def _nearest_visible(self, graph: NavGraph, nodes: np.ndarray, p: np.ndarray, blocked, origin) -> int:
+    def _nearest_visible(self, graph: NavGraph, nodes: np.ndarray, p: np.ndarray, blocked, grid: Grid) -> int:
         """Index (into graph) of the closest of ``nodes`` seeing p, else the closest; -1 if none."""
         if nodes.size == 0:
             return -1
         order = nodes[np.argsort(np.linalg.norm(graph.xy[nodes] - p, axis=1))[: self.config.assignment_k]]
-        seen = line_of_sight(p, graph.xy[order], blocked, origin_xy=np.asarray(origin),
-                             resolution_m=self.config.resolution_m)
+        seen = line_of_sight(p, graph.xy[order], blocked, grid)
         return int(order[np.argmax(seen)] if seen.any() else order[0])
 
-    def _robot_component(self, graph: NavGraph, robot: np.ndarray, blocked, origin) -> np.ndarray:
+    def _robot_component(self, graph: NavGraph, robot: np.ndarray, blocked, grid: Grid) -> np.ndarray:
         """Node mask of the (door-uncut) graph component the robot stands in."""
-        node = self._nearest_visible(graph, np.arange(graph.n_nodes), robot, blocked, origin)
+        node = self._nearest_visible(graph, np.arange(graph.n_nodes), robot, blocked, grid)
         if node < 0:
             return np.zeros(graph.n_nodes, dtype=bool)
         comp = graph.components()
         return comp == comp[node]
 
-    def _attach(self, graph: NavGraph, labels: np.ndarray, points: np.ndarray, blocked, origin) -> np.ndarray:
+    def _attach(self, graph: NavGraph, labels: np.ndarray, points: np.ndarray, blocked, grid: Grid) -> np.ndarray:
         """Node index (labelled nodes only, -1 if none) each point belongs to."""
         labelled = np.flatnonzero(labels >= 0)
-        return np.array([self._nearest_visible(graph, labelled, p, blocked, origin) for p in points], dtype=np.int64)
+        return np.array([self._nearest_visible(graph, labelled, p, blocked, grid) for p in points], dtype=np.int64)
 
     def _stable_ids(self, graph: NavGraph, labels: np.ndarray) -> list[str]:
         """Region id per label, inheriting ids through remembered anchors (see module docstring)."""
@@ -192,7 +192,7 @@ class SceneGraphBuilder:
         return ids
 
     def _assemble(self, rg: RegionGraph, region_ids: list[str], keep: np.ndarray, objects: list[int],
-                  frontier_node: np.ndarray, robot: np.ndarray, occ: np.ndarray, origin) -> SceneGraph:
+                  frontier_node: np.ndarray, robot: np.ndarray, occ: np.ndarray, grid: Grid) -> SceneGraph:
         """Put the pipeline's graph, reduced to the ``keep`` node mask, into the data model."""
         graph, labels = rg.graph, rg.labels
         sub_index = np.cumsum(keep) - 1
@@ -235,8 +235,7 @@ class SceneGraphBuilder:
             nav=NavGraphData(node_xy=graph.xy[keep], edges=sub_index[graph.edges[emask]],
                              weights=graph.weights[emask], door_edges=rg.cut[emask],
                              node_region=node_region),
-            occupancy=OccupancyMap(grid=occ, origin_xy=(float(origin[0]), float(origin[1])),
-                                   resolution_m=self.config.resolution_m),
+            occupancy=OccupancyMap(grid=occ, origin_xy=grid.origin_xy, resolution_m=grid.resolution_m),
         )
 
     def _relations(self, placed: list[ObjectNode]) -> list[Relation]:

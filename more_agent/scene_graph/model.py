@@ -22,6 +22,8 @@ import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSerializer, PrivateAttr, model_validator
 from scipy.spatial import cKDTree
 
+from more_agent.sim.grid import Grid
+
 SCHEMA_VERSION = 2
 
 Vec2 = tuple[float, float]
@@ -125,12 +127,16 @@ class NavGraphData(_Model):
 
 
 class OccupancyMap(_Model):
-    """BEV occupancy for A*: 0 unknown, 1 free, 2 occupied; grid[ix, iy] centre at
-    origin_xy + (ix + 0.5, iy + 0.5) * resolution_m."""
+    """BEV occupancy for A*: 0 unknown, 1 free, 2 occupied; ``grid[ix, iy]`` on the ``frame`` Grid."""
 
     grid: IntArray = Field(description="(nx, ny) cell values.")
     origin_xy: Vec2 = Field(description="World position of the grid's corner, metres.")
     resolution_m: float = Field(description="Cell size, metres.")
+
+    @property
+    def frame(self) -> Grid:
+        """The :class:`~more_agent.sim.grid.Grid` that ``grid`` lies on."""
+        return Grid(origin_xy=self.origin_xy, resolution_m=self.resolution_m)
 
 
 class SceneGraph(_Model):

@@ -40,7 +40,7 @@ from more_agent.sim import actions, motion
 from more_agent.sim.camera import Camera
 from more_agent.sim.goals import GoalChecker, GoalStatus
 from more_agent.sim.instantiate import TaskInstance, instantiate
-from more_agent.sim.navgrid import nav_grid
+from more_agent.sim.navgrid import free_cells, nav_grid
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.world import World
@@ -207,11 +207,10 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         """Put the robot at a free navigation cell and heading drawn from ``np_random``."""
         assert self.world is not None
         grid = nav_grid(self.world)
-        rows, cols = np.nonzero(grid.free)
-        if len(rows) == 0:
+        cells = free_cells(grid.free)
+        if len(cells) == 0:
             raise ValueError(f"scene {self.world.scene.name} has no free space for the robot")
-        k = int(self.np_random.integers(len(rows)))
-        x, y = grid.to_xy(int(rows[k]), int(cols[k]))
+        x, y = grid.centre(cells[int(self.np_random.integers(len(cells)))])
         self.world.set_robot_pose(x, y, float(self.np_random.uniform(-math.pi, math.pi)))
 
     def _move(self, kind: str, amount: float) -> motion.MotionResult:

@@ -10,6 +10,11 @@ Grids depend only on the world's fixed geometry and on which doors are closed, s
 per (world, closed doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
 simplified to polylines. ``blocking_door`` names the closed door on the way when a goal is only
 reachable with doors open: the magic actions report it so that a planner knows what to open.
+
+Rasters are ``free[ix, iy]`` on a :class:`~more_agent.sim.grid.Grid`. The searches (nearest free
+cell, shortest path, its simplification) run on the raster transposed to ``[iy, ix]``: how they
+break ties between equally good cells depends on the layout, and every recorded episode was made
+with that one. Cells go in and come out as (ix, iy).
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ from scipy import ndimage
 from skimage.graph import MCP_Geometric
 from skimage.measure import approximate_polygon
 
+from more_agent.sim.grid import Grid
 from more_agent.sim.scene import Bounds2D, Door
 from more_agent.sim.world import World
 
@@ -52,61 +58,63 @@ DEFAULT_NAV = NavConfig()
 _CACHE_SIZE = 16
 
 
-@dataclass(frozen=True, eq=False)
-class NavGrid:
-    """Boolean free-space raster: ``free[row, col]`` with row along +y and col along +x."""
+@dataclass(frozen=True, eq=False, kw_only=True)
+class NavGrid(Grid):
+    """Boolean free-space raster on a :class:`~more_agent.sim.grid.Grid`: ``free[ix, iy]``."""
 
     free: np.ndarray
-    origin: XY
-    resolution_m: float
     closed_doors: frozenset[str]
     door_cells: dict[str, np.ndarray] = field(repr=False)
     """Per door id, a boolean mask of its passage strip (used to name a blocking door)."""
+
+    __eq__ = object.__eq__  # a raster is itself, not its Grid's placement
+    __hash__ = object.__hash__
 
     @property
     def shape(self) -> tuple[int, int]:
         return self.free.shape  # type: ignore[return-value]
 
-    def to_cell(self, x: float, y: float) -> tuple[int, int]:
-        """The (row, col) of the cell containing (x, y), clipped to the grid."""
-        r = int(np.floor((y - self.origin[1]) / self.resolution_m))
-        c = int(np.floor((x - self.origin[0]) / self.resolution_m))
-        return min(max(r, 0), self.shape[0] - 1), min(max(c, 0), self.shape[1] - 1)
+    def cell_at(self, x: float, y: float) -> tuple[int, int]:
+        """The (ix, iy) of the cell containing (x, y), clipped to the grid."""
+        ix, iy = self.cell_of((x, y))
+        return min(max(int(ix), 0), self.shape[0] - 1), min(max(int(iy), 0), self.shape[1] - 1)
 
-    def to_xy(self, r: int, c: int) -> XY:
-        """World coordinates of a cell's centre."""
-        return (self.origin[0] + (c + 0.5) * self.resolution_m, self.origin[1] + (r + 0.5) * self.resolution_m)
+    def centre(self, cell: tuple[int, int]) -> XY:
+        """World coordinates of a cell's centre, as plain floats."""
+        x, y = self.xy_of(cell)
+        return float(x), float(y)
 
     def is_free(self, x: float, y: float) -> bool:
         """Whether the robot base may stand at (x, y)."""
-        r, c = self.to_cell(x, y)
-        inside = self.origin[0] <= x < self.origin[0] + self.shape[1] * self.resolution_m and (
-            self.origin[1] <= y < self.origin[1] + self.shape[0] * self.resolution_m
-        )
-        return inside and bool(self.free[r, c])
+        ix, iy = self.cell_of((x, y))
+        return bool(0 <= ix < self.shape[0] and 0 <= iy < self.shape[1] and self.free[ix, iy])
 
     @cached_property
     def _nearest_free(self) -> tuple[np.ndarray, np.ndarray]:
-        _, (rows, cols) = ndimage.distance_transform_edt(~self.free, return_indices=True)
-        return rows, cols
+        # y-major, see the module docstring
+        _, (iys, ixs) = ndimage.distance_transform_edt(~self.free.T, return_indices=True)
+        return ixs.T, iys.T
 
     def snap(self, x: float, y: float) -> tuple[int, int] | None:
         """The free cell nearest to (x, y), or None when the grid has no free cell."""
         if not self.free.any():
             return None
-        r, c = self.to_cell(x, y)
-        rows, cols = self._nearest_free
-        return int(rows[r, c]), int(cols[r, c])
+        cell = self.cell_at(x, y)
+        ixs, iys = self._nearest_free
+        return int(ixs[cell]), int(iys[cell])
 
 
-def _mask_box(shape: tuple[int, int], origin: XY, res: float, box: Bounds2D) -> tuple[slice, slice]:
-    """Row/col slices of the cells whose centres lie inside ``box``."""
-    x0, y0, x1, y1 = box
-    c0 = int(np.ceil((x0 - origin[0]) / res - 0.5))
-    c1 = int(np.floor((x1 - origin[0]) / res - 0.5)) + 1
-    r0 = int(np.ceil((y0 - origin[1]) / res - 0.5))
-    r1 = int(np.floor((y1 - origin[1]) / res - 0.5)) + 1
-    return slice(max(r0, 0), max(min(r1, shape[0]), 0)), slice(max(c0, 0), max(min(c1, shape[1]), 0))
+def free_cells(mask: np.ndarray) -> np.ndarray:
+    """(k, 2) cells (ix, iy) of the True cells of a ``[ix, iy]`` mask, row by row (iy, then ix):
+    the order in which seeded draws of a cell pick, kept so that a seed gives the same cell."""
+    return np.argwhere(mask.T)[:, ::-1]
+
+
+def _mask_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[slice, slice]:
+    """Slices of the cells whose centres lie inside ``box``."""
+    lo, hi = grid.centre_range(box[:2], box[2:])
+    lo, hi = np.maximum(lo, 0), np.maximum(np.minimum(hi, shape), 0)
+    return slice(int(lo[0]), int(hi[0])), slice(int(lo[1]), int(hi[1]))
 
 
 def _door_strip(door: Door, reach: float) -> Bounds2D:
@@ -118,32 +126,32 @@ def _door_strip(door: Door, reach: float) -> Bounds2D:
 def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
     scene, res = world.scene, config.resolution_m
     bx0, by0, bx1, by1 = scene.bounds
-    origin = (bx0 - res, by0 - res)
-    shape = (int(np.ceil((by1 - by0) / res)) + 2, int(np.ceil((bx1 - bx0) / res)) + 2)
+    grid = Grid(origin_xy=(bx0 - res, by0 - res), resolution_m=res)
+    shape = (int(np.ceil((bx1 - bx0) / res)) + 2, int(np.ceil((by1 - by0) / res)) + 2)
 
     region = np.zeros(shape, dtype=bool)
     for room in scene.rooms:
-        region[_mask_box(shape, origin, res, room.bounds)] = True
+        region[_mask_box(grid, shape, room.bounds)] = True
     blocked = np.zeros(shape, dtype=bool)
     for wall in scene.walls:
-        blocked[_mask_box(shape, origin, res, wall.bounds)] = True
+        blocked[_mask_box(grid, shape, wall.bounds)] = True
     door_cells: dict[str, np.ndarray] = {}
     for door in scene.doors:
         passage = np.zeros(shape, dtype=bool)
-        passage[_mask_box(shape, origin, res, _door_strip(door, config.door_passage_m))] = True
+        passage[_mask_box(grid, shape, _door_strip(door, config.door_passage_m))] = True
         door_cells[door.id] = passage
         region |= passage
         # The opening is a gap in its wall whatever the wall list says; a closed leaf fills it.
-        opening = _mask_box(shape, origin, res, _door_strip(door, door.thickness / 2 + res))
+        opening = _mask_box(grid, shape, _door_strip(door, door.thickness / 2 + res))
         blocked[opening] = door.id in closed
     for obj in world.objects.values():
         if obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m:
-            blocked[_mask_box(shape, origin, res, obj.footprint())] = True
+            blocked[_mask_box(grid, shape, obj.footprint())] = True
 
     passable = region & ~blocked
     clearance = ndimage.distance_transform_edt(passable) * res
     return NavGrid(
-        free=clearance > config.robot_radius_m, origin=origin, resolution_m=res, closed_doors=closed,
+        origin_xy=grid.origin_xy, resolution_m=res, free=clearance > config.robot_radius_m, closed_doors=closed,
         door_cells=door_cells,
     )
 
@@ -189,7 +197,7 @@ class PathResult:
     """Simplified polyline from the start to the goal, both included; empty when unreachable."""
 
     cells: list[tuple[int, int]] = field(repr=False, default_factory=list)
-    """The raw 8-connected cell path."""
+    """The raw 8-connected cell path, (ix, iy) per cell."""
 
     @property
     def found(self) -> bool:
@@ -207,20 +215,21 @@ def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     """
     start_cell = grid.snap(*start)
     goal_index = [i for i, g in enumerate(goals) if grid.is_free(*g)]
-    goal_cells = [grid.to_cell(*goals[i]) for i in goal_index]
+    goal_cells = [grid.cell_at(*goals[i]) for i in goal_index]
     if start_cell is None or not goal_cells:
         return _NO_PATH
-    costs = np.where(grid.free, 1.0, np.inf)
-    mcp = MCP_Geometric(costs)
-    cum, _ = mcp.find_costs([start_cell], goal_cells, find_all_ends=False)
-    reached = [(float(cum[cell]), i) for i, cell in enumerate(goal_cells) if np.isfinite(cum[cell])]
+    mcp = MCP_Geometric(np.where(grid.free.T, 1.0, np.inf))  # y-major: see the module docstring
+    goals_yx = [cell[::-1] for cell in goal_cells]
+    cum, _ = mcp.find_costs([start_cell[::-1]], goals_yx, find_all_ends=False)
+    reached = [(float(cum[yx]), i) for i, yx in enumerate(goals_yx) if np.isfinite(cum[yx])]
     if not reached:
         return _NO_PATH
     cost, k = min(reached)
-    cells = [tuple(map(int, rc)) for rc in mcp.traceback(goal_cells[k])]
-    simplified = approximate_polygon(np.asarray(cells, dtype=float), tolerance=1.0)
+    path_yx = np.asarray(mcp.traceback(goals_yx[k]))
+    cells = [(int(ix), int(iy)) for iy, ix in path_yx]
+    simplified = approximate_polygon(path_yx.astype(float), tolerance=1.0)
     waypoints = [(float(start[0]), float(start[1]))]
-    waypoints += [grid.to_xy(int(round(r)), int(round(c))) for r, c in simplified[1:-1]]
+    waypoints += [grid.centre((int(round(ix)), int(round(iy)))) for iy, ix in simplified[1:-1]]
     waypoints.append((float(goals[goal_index[k]][0]), float(goals[goal_index[k]][1])))
     return PathResult(goal_index=goal_index[k], length_m=cost * grid.resolution_m, waypoints=waypoints, cells=cells)
 
@@ -232,9 +241,9 @@ def blocking_door(world: World, start: XY, goals: Sequence[XY], config: NavConfi
         return None
     open_grid = nav_grid(world, config, all_doors_open=True)
     path = shortest_path(open_grid, start, goals)
-    for r, c in path.cells:
+    for cell in path.cells:
         for door_id in sorted(closed):
-            if open_grid.door_cells[door_id][r, c]:
+            if open_grid.door_cells[door_id][cell]:
                 return door_id
     return None
 

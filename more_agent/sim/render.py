@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from more_agent.sim.camera import Camera
+from more_agent.sim.grid import Grid
 from more_agent.sim.world import SLAB_FRACTION, World, WorldObject
 
 GRID_CELL_M = 1.0
@@ -81,8 +82,8 @@ class SceneGeometry:
     hi: np.ndarray
     semantic: np.ndarray
     instance: np.ndarray
-    origin: tuple[float, float]
-    cell: float
+    grid: Grid
+    """The bucket grid (cells of ``GRID_CELL_M``); the kernels repeat ``Grid.cell_of`` inline."""
     shape: tuple[int, int]
     cell_start: np.ndarray
     cell_items: np.ndarray
@@ -125,7 +126,8 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
     return SceneGeometry(
         lo=lo, hi=hi, semantic=np.array([b[2] for b in boxes], dtype=np.int32),
         instance=np.array([b[3] for b in boxes], dtype=np.int32),
-        origin=(x0, y0), cell=cell_m, shape=(nx, ny), cell_start=start, cell_items=items,
+        grid=Grid(origin_xy=(float(x0), float(y0)), resolution_m=cell_m), shape=(nx, ny),
+        cell_start=start, cell_items=items,
         palette=class_colors(world.class_names).astype(np.float64),
     )
 
@@ -328,7 +330,7 @@ class Renderer:
         inst = np.empty(n, dtype=np.int32)
         rgb = np.empty((n, 3), dtype=np.uint8)
         _cast(np.ascontiguousarray(T[:3, 3]), np.ascontiguousarray(T[:3, :3]), self._rays, cam.max_range_m,
-              g.origin[0], g.origin[1], g.cell, g.shape[0], g.shape[1], g.cell_start, g.cell_items, g.lo, g.hi,
+              *g.grid.origin_xy, g.grid.resolution_m, g.shape[0], g.shape[1], g.cell_start, g.cell_items, g.lo, g.hi,
               g.semantic, g.instance, g.palette, depth, sem, inst, rgb)
         hw = (cam.height, cam.width)
         return Frame(rgb=rgb.reshape(*hw, 3), depth=depth.reshape(hw), semantic=sem.reshape(hw), instance=inst.reshape(hw),

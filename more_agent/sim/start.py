@@ -19,7 +19,7 @@ from scipy import ndimage
 
 from more_agent.errors import UserError
 from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
-from more_agent.sim.navgrid import NavGrid, nav_grid, shortest_path
+from more_agent.sim.navgrid import NavGrid, free_cells, nav_grid, shortest_path
 from more_agent.sim.world import World
 
 MIN_ROOM_FREE_M2 = 1.0
@@ -47,19 +47,13 @@ class StartFacts:
     """Path length from the start to within reach of the nearest task object; None when none is reachable."""
 
 
-def _cell_centres(grid: NavGrid) -> tuple[np.ndarray, np.ndarray]:
-    """(x, y) of every cell centre, each of the grid's shape."""
-    rows, cols = np.indices(grid.shape)
-    return grid.origin[0] + (cols + 0.5) * grid.resolution_m, grid.origin[1] + (rows + 0.5) * grid.resolution_m
-
-
 def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[tuple[int, int]]:
     """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
     cells = []
     for t in targets:
         x0, y0, x1, y1 = reach_box(world, t)
         for poses in candidate_poses(world, t):
-            cells += [grid.to_cell(x, y) for x, y in poses
+            cells += [grid.cell_at(x, y) for x, y in poses
                       if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)]
     return cells
 
@@ -80,17 +74,17 @@ def random_start(
     free = np.isin(components, keep[keep > 0])
     if by_room:
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
-        x, y = _cell_centres(grid)
+        xy = grid.xy_of(np.stack(np.indices(grid.shape), axis=-1))
+        x, y = xy[..., 0], xy[..., 1]
         in_room = [free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
                    for r in world.scene.rooms]
         rooms = [m for m in in_room if m.sum() >= min_cells]
         if rooms:
             free = rooms[rng.integers(len(rooms))]
-    cells = np.flatnonzero(free)
+    cells = free_cells(free)
     if len(cells) == 0:
         return None
-    r, c = np.unravel_index(cells[rng.integers(len(cells))], grid.shape)
-    x, y = grid.to_xy(int(r), int(c))
+    x, y = grid.centre(cells[rng.integers(len(cells))])
     jitter = rng.uniform(-0.5, 0.5, size=2) * grid.resolution_m
     return float(x + jitter[0]), float(y + jitter[1]), float(rng.uniform(-np.pi, np.pi))
 
@@ -98,7 +92,7 @@ def random_start(
 def start_to_task_m(world: World, targets: list[str]) -> float | None:
     """Path length (doors open) from the robot to the nearest pose from which a task object is within reach."""
     grid = nav_grid(world, all_doors_open=True)
-    goals = [grid.to_xy(*c) for c in approach_cells(world, grid, targets)]
+    goals = [grid.centre(c) for c in approach_cells(world, grid, targets)]
     path = shortest_path(grid, (world.robot.x, world.robot.y), goals)
     return round(path.length_m, 3) if path.found else None
 

@@ -27,14 +27,14 @@ def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None =
     fig, ax = plt.subplots(figsize=(8, 8))
     occ = graph.occupancy
     if occ is not None:
-        nx_, ny_ = occ.grid.shape
-        x0, y0 = occ.origin_xy
-        extent = (x0, x0 + nx_ * occ.resolution_m, y0, y0 + ny_ * occ.resolution_m)
-        ax.imshow(occ.grid.T, origin="lower", extent=extent, cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest")
+        x0, y0, x1, y1 = occ.frame.bounds(occ.grid.shape)
+        ax.imshow(occ.grid.T, origin="lower", extent=(x0, x1, y0, y1), cmap=_OCC_CMAP, vmin=0, vmax=2,
+                  interpolation="nearest")  # imshow draws [row, col]: y up the rows
         known = np.argwhere(occ.grid != 0)
         if len(known):  # show the explored part, with a metre around it
-            lo = known.min(0) * occ.resolution_m + np.asarray(occ.origin_xy) - 1.0
-            hi = (known.max(0) + 1) * occ.resolution_m + np.asarray(occ.origin_xy) + 1.0
+            margin = occ.resolution_m / 2 + 1.0
+            lo = occ.frame.xy_of(known.min(0)) - margin
+            hi = occ.frame.xy_of(known.max(0)) + margin
             ax.set_xlim(lo[0], hi[0])
             ax.set_ylim(lo[1], hi[1])
     colours = plt.get_cmap("tab10")

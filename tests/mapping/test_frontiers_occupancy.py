@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from more_agent.mapping import VoxelMap, depth_to_points, frontier_points
+from more_agent.mapping import Grid, VoxelMap, depth_to_points, frontier_points
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
 from tests.scene_graph.boxworld import CID, Box, camera_pose, intrinsics, render
 
@@ -12,7 +12,7 @@ def test_frontier_points_one_per_long_cluster() -> None:
     occ[5:55, 5:30] = FREE
     occ[20:40, 30:55] = UNKNOWN  # opening of 20 cells onto unknown space
     occ[5:7, 30] = UNKNOWN  # 2-cell crack: too short
-    pts, lengths = frontier_points(occ, resolution_m=0.1, origin_xy=(1.0, 2.0), min_length_m=0.5)
+    pts, lengths = frontier_points(occ, Grid(origin_xy=(1.0, 2.0), resolution_m=0.1), min_length_m=0.5)
     assert len(pts) == 1
     assert lengths[0] >= 2.0
     assert 1.0 + 20 * 0.1 <= pts[0, 0] <= 1.0 + 40 * 0.1 and abs(pts[0, 1] - (2.0 + 29.5 * 0.1)) < 1e-9
@@ -41,7 +41,7 @@ def test_floor_is_free_objects_occupied_and_moved_objects_are_cleared() -> None:
     for T in poses:
         vmap.integrate(*render([floor, crate], K, T, 96), K, T)
     occ = vmap.occupancy()
-    cell = lambda x, y: tuple(np.floor((np.array([x, y]) - vmap.origin_xy) / 0.075).astype(int))  # noqa: E731
+    cell = lambda x, y: tuple(vmap.grid.cell_of((x, y)))  # noqa: E731
     assert occ[cell(2.1, 0.0)] == OCCUPIED
     assert occ[cell(1.0, 0.0)] == FREE
     assert occ[cell(-3.0, 0.0)] == UNKNOWN  # behind the camera
@@ -79,6 +79,6 @@ def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
     for yaw in (0.0, 0.4):
         T = camera_pose(0, 0, yaw, pitch_deg=0.0)
         vmap.integrate(*render([floor, lintel, pool], K, T, 96), K, T)
-    cell = tuple(np.floor((np.array([2.07, 0.0]) - vmap.origin_xy) / 0.075).astype(int))
+    cell = tuple(vmap.grid.cell_of((2.07, 0.0)))
     assert vmap.occupancy()[cell] == FREE
     assert 3 in vmap.instance_voxels()

@@ -1,8 +1,10 @@
 """Door kernels cut regions; Eq. 1 assignment respects walls and windows."""
 
 import numpy as np
+import pytest
 
 from more_agent.mapping import (
+    Grid,
     MappingConfig,
     assign_objects,
     door_crossing_edges,
@@ -18,6 +20,7 @@ from more_agent.mapping.occupancy import FREE, OCCUPIED
 from more_agent.mapping.pipeline import STAGES
 
 RES = 0.075
+GRID = Grid(resolution_m=RES)
 
 
 def _two_rooms() -> np.ndarray:
@@ -35,7 +38,7 @@ def _door_points() -> np.ndarray:
 
 
 def _regions(occ: np.ndarray, doors) -> tuple:
-    g, _ = sparsify(voronoi_graph(occ, resolution_m=RES), threshold_m=1.0)
+    g, _ = sparsify(voronoi_graph(occ, GRID), threshold_m=1.0)
     cut = door_crossing_edges(g, doors, threshold_m=0.15)
     return g, cut, segment_regions(g, cut, doors)
 
@@ -68,8 +71,7 @@ def test_merge_subregions_joins_components_of_one_free_patch_only() -> None:
     room_a = labels[np.argmin(g.xy[:, 0])]
     split = labels.copy()
     split[(labels == room_a) & (g.xy[:, 1] > 30 * RES)] = labels.max() + 1
-    cells = np.floor(g.xy / RES).astype(int)
-    merged = merge_subregions(split, cells, occ, doorway_mask(occ.shape, [door], resolution_m=RES))
+    merged = merge_subregions(split, GRID.cell_of(g.xy), occ, doorway_mask(occ.shape, GRID, [door]))
     assert merged.max() == 1
     np.testing.assert_array_equal(merged >= 0, labels >= 0)
 
@@ -81,12 +83,14 @@ def test_object_goes_to_its_room_not_the_one_behind_the_wall() -> None:
     obj = np.array([[46.5 * RES, 8.5 * RES]])
     vp = np.array([[25 * RES, 30 * RES]])  # robot in room A
     label_a = labels[np.argmin(np.linalg.norm(g.xy - vp, axis=1))]
-    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=occ == OCCUPIED, resolution_m=RES)
+    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=occ == OCCUPIED, grid=GRID)
     assert got[0] == label_a
     # even seen from room B, the wall keeps nodes of B out of S_O
     vp_b = np.array([[75 * RES, 30 * RES]])
-    got_b = assign_objects(g, labels, obj, vp_b, cut=cut, blocked=occ == OCCUPIED, resolution_m=RES)
+    got_b = assign_objects(g, labels, obj, vp_b, cut=cut, blocked=occ == OCCUPIED, grid=GRID)
     assert got_b[0] == label_a
+    with pytest.raises(ValueError, match="grid"):  # a blocked mask means nothing without its placement
+        assign_objects(g, labels, obj, vp, cut=cut, blocked=occ == OCCUPIED)
 
 
 def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
@@ -100,7 +104,7 @@ def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
     vp = np.array([[56 * RES, 31 * RES]])  # garden viewpoint, 0.7 m from the wall
     window_wall = np.zeros_like(occ, dtype=bool)
     window_wall[50:52, :] = True
-    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=window_wall, resolution_m=RES)
+    got = assign_objects(g, labels, obj, vp, cut=cut, blocked=window_wall, grid=GRID)
     indoor = labels[np.argmin(np.linalg.norm(g.xy - obj, axis=1) + 100 * (g.xy[:, 0] > 50 * RES))]
     assert got[0] == indoor
 
@@ -108,7 +112,7 @@ def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
 def test_region_graph_chains_the_stages_and_times_each() -> None:
     occ = _two_rooms()
     obj = np.array([[25 * RES, 10 * RES], [75 * RES, 50 * RES]])
-    rg = region_graph(occ, door_points=[_door_points()], objects_xy=obj, viewpoints_xy=obj,
+    rg = region_graph(occ, GRID, door_points=[_door_points()], objects_xy=obj, viewpoints_xy=obj,
                       blocked=occ == OCCUPIED, config=MappingConfig(resolution_m=RES))
     g, cut, labels = _regions(occ, [fit_door_kernel(_door_points())])
     np.testing.assert_array_equal(rg.graph.xy, g.xy)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.sparse import csgraph
 
-from more_agent.mapping import NavGraph, sparsify, voronoi_graph
+from more_agent.mapping import Grid, NavGraph, sparsify, voronoi_graph
 from more_agent.mapping.occupancy import FREE, OCCUPIED
 
 
@@ -55,7 +55,7 @@ def test_invariants_on_a_voronoi_graph_and_strong_reduction() -> None:
     occ = np.full((120, 160), OCCUPIED, dtype=np.int8)
     occ[5:115, 5:155] = FREE
     occ[40:80, 60:100] = OCCUPIED  # a pillar makes a cycle
-    dense = voronoi_graph(occ, resolution_m=0.075)
+    dense = voronoi_graph(occ, Grid(resolution_m=0.075))
     _check_invariants(dense, threshold=1.0)
     sparse, _ = sparsify(dense, threshold_m=1.0)
     assert sparse.n_nodes < dense.n_nodes / 5

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy import ndimage
 
-from more_agent.mapping import voronoi_graph
+from more_agent.mapping import Grid, voronoi_graph
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
 
 
@@ -18,7 +18,7 @@ def test_nodes_lie_on_free_cells_with_clearance_and_edges_are_metric() -> None:
     occ[12:88, 12:68] = FREE
     occ[50:52, 12:68] = OCCUPIED
     occ[50:52, 35:47] = FREE  # door gap
-    g = voronoi_graph(occ, resolution_m=res, origin_xy=origin, inflation_m=0.15)
+    g = voronoi_graph(occ, Grid(origin_xy=origin, resolution_m=res), inflation_m=0.15)
     cells = _cells(g.xy, origin, res)
     assert (occ[cells[:, 0], cells[:, 1]] == FREE).all()
     clearance = ndimage.distance_transform_edt(occ == FREE) * res
@@ -29,8 +29,8 @@ def test_nodes_lie_on_free_cells_with_clearance_and_edges_are_metric() -> None:
 
 
 def test_empty_and_obstacle_only_maps_give_empty_graphs() -> None:
-    assert voronoi_graph(np.zeros((20, 20), np.int8), resolution_m=0.1).n_nodes == 0
-    assert voronoi_graph(np.full((20, 20), OCCUPIED, np.int8), resolution_m=0.1).n_nodes == 0
+    assert voronoi_graph(np.zeros((20, 20), np.int8), Grid(resolution_m=0.1)).n_nodes == 0
+    assert voronoi_graph(np.full((20, 20), OCCUPIED, np.int8), Grid(resolution_m=0.1)).n_nodes == 0
 
 
 def test_generated_apartment_graph_is_connected() -> None:
@@ -43,7 +43,7 @@ def test_generated_apartment_graph_is_connected() -> None:
         world.set_open(door.id, True)
     free = nav_grid(world).free.T  # navgrid rows are y; occupancy grids index (x, y)
     occ = np.where(free, FREE, OCCUPIED).astype(np.int8)
-    g = voronoi_graph(occ, resolution_m=0.075)
+    g = voronoi_graph(occ, Grid(resolution_m=0.075))
     assert g.n_nodes > 100
     comps = np.bincount(g.components())
     assert comps.max() > 0.95 * g.n_nodes

@@ -45,7 +45,7 @@ def test_agent_grid_keeps_clear_of_obstacles_and_unknown() -> None:
     grid[10, :] = OCCUPIED
     grid[:, 0] = 0  # unknown column
     nav = agent_nav_grid(OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25)
-    free = nav.free.T  # back to [ix, iy]
+    free = nav.free
     assert not free[:, 0].any() and not free[8:13, :].any() and free[15, 5] and free[5, 5]
     path, index = path_to_nearest(nav, (0.35, 0.35), [(1.55, 0.55), (0.85, 0.65)], snap_m=0.5)
     assert index == 1 and path.found  # the nearer goal lies beyond the wall: unreachable

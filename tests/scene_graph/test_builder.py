@@ -78,9 +78,9 @@ def test_window_object_goes_indoors_and_unreachable_regions_are_dropped() -> Non
     # Eq. 1 on the builder's own map: the cabinet, seen only from the garden, is indoors
     vox = builder.voxels
     voxels = vox.instance_voxels()
-    rg = region_graph(vox.occupancy(), door_points=[voxels[1][:, :2]], objects_xy=voxels[2].mean(0)[None, :2],
+    rg = region_graph(vox.occupancy(), vox.grid, door_points=[voxels[1][:, :2]], objects_xy=voxels[2].mean(0)[None, :2],
                       viewpoints_xy=np.array([[4.7, 1.0]]), blocked=np.isin(vox.top_class, builder._structure_ids),
-                      origin_xy=tuple(vox.origin_xy), config=builder.config)
+                      config=builder.config)
     assert rg.graph.xy[rg.labels == rg.assigned[0]][:, 0].max() < 4.0
     # exploring inside makes the indoor region reachable with the cabinet in it
     explore(builder, boxes, infos, [(2.0, 2.5), (2.0, 1.6)], n_yaw=8)
@@ -109,8 +109,7 @@ def test_frontiers_point_into_unexplored_space() -> None:
     g = builder.build((2.0, 2.0))
     fronts = [p for r in g.regions.values() for p in g.frontiers(r.id)]
     assert fronts
-    assert all(g.occupancy.grid[tuple(np.floor((np.array(p) - g.occupancy.origin_xy) / 0.075).astype(int))] == 1
-               for p in fronts)
+    assert all(g.occupancy.grid[tuple(g.occupancy.frame.cell_of(p))] == 1 for p in fronts)
 
 
 def test_json_round_trip_networkx_and_closest_node(explored) -> None:

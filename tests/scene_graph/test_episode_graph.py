@@ -23,7 +23,7 @@ def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> Non
     body = Embodiment(world)
     for room in world.scene.rooms:
         x0, y0, x1, y1 = room.bounds
-        world.set_robot_pose(*grid.to_xy(*grid.snap((x0 + x1) / 2, (y0 + y1) / 2)), 0.0)
+        world.set_robot_pose(*grid.centre(grid.snap((x0 + x1) / 2, (y0 + y1) / 2)), 0.0)
         body.look_around()
     graph = body.build()
 

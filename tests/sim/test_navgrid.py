@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from more_agent.sim.navgrid import NavConfig, blocking_door, nav_grid, reachable, shortest_path
+from more_agent.sim.navgrid import NavConfig, blocking_door, free_cells, nav_grid, reachable, shortest_path
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall
 from more_agent.sim.world import World, WorldObject
 
@@ -88,3 +90,18 @@ def test_grid_cached_per_door_state():
     assert closed is not first and closed.closed_doors == frozenset({"door_0"})
     world.set_open("door_0", True)
     assert nav_grid(world) is first
+
+
+def test_grid_is_indexed_x_first_and_cells_round_trip():
+    grid = nav_grid(two_room_world())
+    lo_x, lo_y, hi_x, hi_y = grid.bounds(grid.shape)
+    assert hi_x - lo_x > hi_y - lo_y  # the two rooms lie side by side along x: the first axis is x
+    cell = grid.cell_at(2.5, 1.0)
+    assert grid.free[cell] and math.dist(grid.centre(cell), (2.5, 1.0)) <= grid.resolution_m / math.sqrt(2)
+    assert not grid.free[grid.cell_at(7.5, 2.0)]  # the table
+    assert grid.cell_at(-100.0, 100.0) == (0, grid.shape[1] - 1)  # clipped
+
+
+def test_free_cells_walk_row_by_row():
+    mask = np.array([[True, True], [True, False]])  # [ix, iy]
+    assert free_cells(mask).tolist() == [[0, 0], [1, 0], [0, 1]]

@@ -29,31 +29,30 @@ def agent_nav_grid(
     """The traversable raster of the agent's map: seen-free cells, and unknown cells within
     ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
     ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed)."""
-    grid = np.asarray(occupancy.grid).T.copy()  # model is [ix, iy]; NavGrid is [row = y, col = x]
-    bumps = _cells(occupancy, bumped_xy, grid.shape)
-    grid[bumps[:, 1], bumps[:, 0]] = OCCUPIED
+    grid = np.array(occupancy.grid)
+    bumps = _cells(occupancy, bumped_xy)
+    grid[bumps[:, 0], bumps[:, 1]] = OCCUPIED
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
     known_free = grid == FREE
     if len(stood_xy) and blind_radius_m > 0:
-        cells = _cells(occupancy, stood_xy, grid.shape)
+        cells = _cells(occupancy, stood_xy)
         seeds = np.ones(grid.shape, dtype=bool)
-        seeds[cells[:, 1], cells[:, 0]] = False
+        seeds[cells[:, 0], cells[:, 1]] = False
         near = ndimage.distance_transform_edt(seeds) * occupancy.resolution_m <= blind_radius_m
         known_free |= near & (grid != OCCUPIED)
     free = known_free & (clearance > inflation_m)
     return NavGrid(
-        free=free, origin=tuple(occupancy.origin_xy), resolution_m=occupancy.resolution_m,
+        origin_xy=occupancy.origin_xy, resolution_m=occupancy.resolution_m, free=free,
         closed_doors=frozenset(), door_cells={},
     )
 
 
-def _cells(occupancy: OccupancyMap, points: Sequence[XY], shape: tuple[int, ...]) -> np.ndarray:
-    """(n, 2) integer (ix, iy) cells of the points that lie on the grid of ``shape`` (rows = iy)."""
+def _cells(occupancy: OccupancyMap, points: Sequence[XY]) -> np.ndarray:
+    """(n, 2) integer (ix, iy) cells of the points that lie on the occupancy grid."""
     if not len(points):
         return np.zeros((0, 2), dtype=int)
-    cells = np.floor((np.asarray(points, dtype=float) - occupancy.origin_xy) / occupancy.resolution_m).astype(int)
-    inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < shape[1]) & (cells[:, 1] < shape[0])
-    return cells[inside]
+    cells = occupancy.frame.cell_of(points)
+    return cells[((cells >= 0) & (cells < occupancy.grid.shape)).all(axis=1)]
 
 
 def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | None]:
@@ -61,7 +60,7 @@ def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | No
     out: list[XY | None] = []
     for g in goals:
         cell = grid.snap(*g)
-        xy = grid.to_xy(*cell) if cell is not None else None
+        xy = grid.centre(cell) if cell is not None else None
         out.append(xy if xy is not None and math.dist(xy, g) <= max_m else None)
     return out
 
