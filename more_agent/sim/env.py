@@ -25,14 +25,15 @@ episode goes on.
 "world": World})``: an injected instance is used as is; so is an injected world (no task, the
 robot where it stands); a task is instantiated (seed ``task_seed``, else drawn from
 ``np_random``); a scene alone (default ``DEFAULT_SCENE``) gets no task and a start pose drawn from
-``np_random`` among the free cells of the navigation grid. Every episode starts with a full turn
-in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
+``np_random`` among the free cells of the navigation grid. With sensors every episode starts with
+a full turn in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
 view after it. ``info["path_frames"]`` likewise holds views along a magic navigation's path every
 ``path_frame_spacing_m``. ``terminated`` when ``done`` is taken; ``truncated`` after ``max_steps``
 steps (never when ``max_steps`` is None). The reward is the change in goal progress (0 without a task).
 
 ``info`` carries what the agent could know: the action's outcome and feedback, step counts, the
-path of a magic navigation and the instance table of the view. Goal state is privileged: only an
+path of a magic navigation, the closed door that blocked it (``blocking``) and the instance table
+of the view. Goal state is privileged: only an
 env built with ``privileged_info=True`` adds ``info["goal_status"]`` (a ``GoalStatus``: per-conjunct
 status, ``all_met``, ``progress``), for evaluation code and tests, never for a planner under test.
 """

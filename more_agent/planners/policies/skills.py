@@ -23,7 +23,7 @@ from more_agent.sim import actions
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.world import floor_name
-from more_agent.skills import Skill, skill_named
+from more_agent.skills import Skill, Subpolicy, skill_named
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
@@ -187,7 +187,8 @@ class Area:
 Target = ObjectNode | Area | None
 """What a skill acts on: a scene-graph object, an area, or nothing (done)."""
 
-Subpolicy = Callable[[Embodiment, SceneGraph, Skill, Target], ActionResult]
+SubpolicyFn = Callable[[Embodiment, SceneGraph, Skill, Target], ActionResult]
+"""A subpolicy as the table dispatches to it: the robot, the step's scene graph, the skill, its target."""
 
 
 def _explore(body: Embodiment, graph: SceneGraph, skill: Skill, target: Target) -> ActionResult:
@@ -225,7 +226,7 @@ def _cannot(skill: Skill, target: Target) -> ActionResult:
     return _fail(FailureReason.INVALID_TARGET, f"cannot {skill.name} {where}")
 
 
-SUBPOLICIES: dict[str, Subpolicy] = {"explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done}
+SUBPOLICIES: dict[Subpolicy, SubpolicyFn] = {"explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done}
 """The planners' binding of the skill table's subpolicies (:attr:`more_agent.skills.Skill.subpolicy`)
 to the functions that run them."""
 
