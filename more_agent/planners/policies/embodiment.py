@@ -2,7 +2,8 @@
 
 The robot steps the world only through the Gymnasium env (:class:`more_agent.sim.env.MoreAgentEnv`,
 built without sensors, goal or privileged info): every low-level action (7.5 cm forward moves, turns
-of at most 35 degrees) and every magic action is one ``env.step``, and is counted; frames are rendered and fused into the
+of at most 35 degrees) and every magic action is one ``env.step``, and is counted. Frames are
+rendered by the robot's own camera and fused into the
 :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
 moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
 Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
@@ -159,10 +160,9 @@ class Embodiment:
         ..., ``done``) on ``target``, a world name or label. Its steps and path are not accounted here
         (the oracle reports them itself; the subpolicies pass them to :meth:`record_jump`)."""
         info = self._step(kind, target=target)
-        return ActionResult(
-            ok=info["action_ok"], reason=FailureReason(info["reason"]) if info["reason"] else None, feedback=info["feedback"],
-            low_level_steps=info["low_level_steps"], path=info["path"], blocking=info["blocking"],
-        )
+        reason = FailureReason(info["reason"]) if info["reason"] else None
+        return ActionResult(ok=info["action_ok"], reason=reason, feedback=info["feedback"],
+                            low_level_steps=info["low_level_steps"], path=info["path"], blocking=info["blocking"])
 
     def _step(self, kind: str, *, target: str = "", amount: float | None = None) -> dict[str, Any]:
         """``env.step`` of action type ``kind`` (:data:`~more_agent.sim.env.ACTION_TYPES`); its info."""

@@ -226,7 +226,9 @@ def _cannot(skill: Skill, target: Target) -> ActionResult:
     return _fail(FailureReason.INVALID_TARGET, f"cannot {skill.name} {where}")
 
 
-SUBPOLICIES: dict[Subpolicy, SubpolicyFn] = {"explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done}
+SUBPOLICIES: dict[Subpolicy, SubpolicyFn] = {
+    "explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done,
+}
 """The planners' binding of the skill table's subpolicies (:attr:`more_agent.skills.Skill.subpolicy`)
 to the functions that run them."""
 
