@@ -13,6 +13,7 @@ from collections.abc import Iterable, Sequence
 
 from more_agent.records import ActionRecord, EpisodeRecord, Failure, FailureCause
 from more_agent.sim.world import World
+from more_agent.skills import SKILLS
 
 CAUSE_ORDER: tuple[FailureCause, ...] = (
     "llm_error", "other", "done_not_called", "wrong_instance", "never_observed", "invalid_llm_answers",
@@ -29,7 +30,8 @@ INVALID_ACTION = "invalid"
 INVALID_SHARE = 0.5
 """An episode whose share of invalid actions reaches this failed on the LLM's answers."""
 
-MANIPULATING = ("go_to_and_grasp", "go_to_and_place_inside", "go_to_and_place_ontop", "go_to_and_open", "go_to_and_close")
+MANIPULATING = frozenset(s.name for s in SKILLS if s.changes_world)
+"""The skills that act on an object (grasp, place, open, close)."""
 
 
 def is_reach_failure(action: ActionRecord) -> bool:

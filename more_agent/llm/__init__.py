@@ -6,21 +6,21 @@ Typical use by a planner::
     config = load_llm_config()                      # file + environment
     client = make_client(parse_llm_spec("openai:gpt-4o"), config)
     out = ask_validated(client, plan_messages(...), PlanAnswer,
-                        lambda a: parse_plan_answer(a, DEFAULT_SKILLS, rooms, objects), purpose="plan")
+                        lambda a: parse_plan_answer(a, SKILLS, rooms, objects), purpose="plan")
     out.value  # PlannedAction
+
+The skills are those of the table :data:`more_agent.skills.SKILLS`.
 
 Importing this package builds no client and does not import the ``openai`` SDK.
 """
 
 from more_agent.llm.answers import (
-    DEFAULT_SKILLS,
     FilterAnswer,
     FilterResult,
     PlanAnswer,
     PlannedAction,
     RoomLabelAnswer,
     RoomObjects,
-    Skill,
 )
 from more_agent.llm.cache import ResponseCache
 from more_agent.llm.client import Backend, ChatClient, ChatRequest, Generation, LLMClient
@@ -53,7 +53,6 @@ from more_agent.llm.spec import LLMSpec, configured_llm, llm_configured, make_cl
 from more_agent.llm.usage import UsageMeter
 
 __all__ = [
-    "DEFAULT_SKILLS",
     "Backend",
     "BadLLMSpec",
     "CacheMode",
@@ -88,7 +87,6 @@ __all__ = [
     "ResponseCache",
     "RoomLabelAnswer",
     "RoomObjects",
-    "Skill",
     "StructuredOutput",
     "TokenUsage",
     "Unparseable",

@@ -1,4 +1,5 @@
-"""The skill API and the shapes of the three LLM answers (room label, scene filter, next action).
+"""The shapes of the three LLM answers (room label, scene filter, next action); the skills they
+name are those of the table in :mod:`more_agent.skills`.
 
 The pydantic answer models double as JSON schemas for structured output: every field is required
 and extra keys are forbidden, as OpenAI's strict mode wants. The validated results the planners
@@ -9,38 +10,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
-
-ParamKind = Literal["room", "object"]
-
-
-@dataclass(frozen=True)
-class Skill:
-    """One subpolicy the planner may call: name, parameter kinds in order, one-line description."""
-
-    name: str
-    params: tuple[ParamKind, ...]
-    description: str
-
-    @property
-    def signature(self) -> str:
-        """E.g. ``navigate(room, object)``."""
-        return f"{self.name}({', '.join(self.params)})"
-
-
-DEFAULT_SKILLS: tuple[Skill, ...] = (
-    Skill("explore", ("room",), "explore the closest unexplored area (frontier) in the room"),
-    Skill("navigate", ("room", "object"), "go to the object"),
-    Skill("go_to_and_open", ("room", "object"), "go to the object and open it"),
-    Skill("go_to_and_close", ("room", "object"), "go to the object and close it"),
-    Skill("go_to_and_grasp", ("room", "object"), "go to the object and pick it up (the hand must be empty)"),
-    Skill("go_to_and_place_inside", ("room", "object"), "go to the object and put the held object inside it"),
-    Skill("go_to_and_place_ontop", ("room", "object"), "go to the object and put the held object on top of it"),
-    Skill("done", (), "end the episode because the task is complete"),
-)
-"""The paper's subpolicies (Sec. III-C)."""
 
 
 class _Answer(BaseModel):

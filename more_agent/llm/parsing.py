@@ -14,10 +14,11 @@ from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import Any
 
 from more_agent.errors import closest_names
-from more_agent.llm.answers import FilterResult, PlannedAction, Skill
+from more_agent.llm.answers import FilterResult, PlannedAction
 from more_agent.llm.errors import InvalidAnswer
 from more_agent.llm.jsontext import extract_json
 from more_agent.llm.limits import MAX_NAME_CHARS, MAX_REASONING_CHARS, clip
+from more_agent.skills import Skill
 
 Answer = str | Mapping[str, Any]
 """An answer as text or as its JSON object."""

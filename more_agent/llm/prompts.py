@@ -15,8 +15,8 @@ from importlib import resources
 from string import Template
 from typing import Protocol
 
-from more_agent.llm.answers import DEFAULT_SKILLS, Skill
 from more_agent.llm.completion import ChatMessage
+from more_agent.skills import SKILLS, Skill
 
 PROMPT_NAMES = ("room", "filter", "plan")
 VLM_PROMPT_NAMES = ("bumble_plan", "bumble_landmark", "bumble_object", "bumble_explore", "bumble_verify")
@@ -67,12 +67,15 @@ class HistoryItem(Protocol):
     feedback: str
 
 
-def skill_api_text(skills: Iterable[Skill]) -> str:
-    """One line per skill: signature and description."""
+def skill_api_text(skills: Iterable[Skill], *, vlm: bool = False) -> str:
+    """One line per skill: signature and description; for the VLM, which names a skill without
+    arguments (later questions pick its target), ``name()`` and the VLM description."""
+    if vlm:
+        return "\n".join(f"- {s.name}(): {s.vlm_description}" for s in skills)
     return "\n".join(f"- {s.signature}: {s.description}" for s in skills)
 
 
-LASTING_SKILLS = frozenset({"go_to_and_grasp", "go_to_and_place_inside", "go_to_and_place_ontop", "go_to_and_open", "go_to_and_close"})
+LASTING_SKILLS = frozenset(s.name for s in SKILLS if s.changes_world)
 """Skills whose success changes the world until undone: the history keeps them beyond the last five."""
 
 
@@ -109,7 +112,7 @@ def plan_messages(
     held_object: str | None,
     history: Sequence[HistoryItem],
     feedback: str,
-    skills: Sequence[Skill] = DEFAULT_SKILLS,
+    skills: Sequence[Skill] = SKILLS,
 ) -> list[ChatMessage]:
     """Planning prompt (paper Fig. 4) for the filtered scene text and the robot's state."""
     return render_prompt(

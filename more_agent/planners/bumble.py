@@ -52,14 +52,7 @@ from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
 from more_agent.planners.llm_planner import INVALID, STEPS_FILE, make_clients
-from more_agent.planners.policies import (
-    MANIPULATION_SKILLS,
-    Embodiment,
-    PolicyConfig,
-    explore_frontiers,
-    go_to_and,
-    navigate,
-)
+from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
@@ -78,7 +71,7 @@ from more_agent.planners.vlm_prompts import (
     step_messages,
 )
 from more_agent.records import ActionRecord, LLMUsage
-from more_agent.scene_graph import ObjectNode, SceneGraph
+from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame
@@ -383,24 +376,21 @@ class BumblePlanner:
     # -- acting ---------------------------------------------------------------------------------
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
-        if action.name == DONE:
-            return ActionResult(ok=True, reason=None, feedback="done")
         if action.name == INVALID:
             return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
         decision, body, graph = self.decision, self._body(), self._graph()
+        if action.name == DONE:
+            return run_skill(body, graph, DONE, None)
         if decision.failure:
             return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=decision.failure)
-        if action.name == "explore":
-            first = len(self.memory.frames)
-            result = explore_frontiers(body, graph, decision.frontiers, "the chosen frame")
-            if not result.ok:
-                return result
-            achieved, feedback = self._verdict(decision.subtask, self.memory.since(first))
-            return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
-        target: ObjectNode = graph.objects[decision.target or ""]
-        if action.name == "navigate":
-            return navigate(body, graph, target)
-        return go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
+        if action.name != "explore":
+            return run_skill(body, graph, action.name, graph.objects[decision.target or ""])
+        first = len(self.memory.frames)
+        result = run_skill(body, graph, action.name, Area("the chosen frame", frontiers=decision.frontiers))
+        if not result.ok:
+            return result
+        achieved, feedback = self._verdict(decision.subtask, self.memory.since(first))
+        return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def _write_step(self, out: Path, action: HighLevelAction) -> None:

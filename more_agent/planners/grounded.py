@@ -36,8 +36,8 @@ from dataclasses import dataclass
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.language import room_names
 from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
-from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
-from more_agent.planners.policies.skills import place_on_floor, without_visited_frontiers
+from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
+from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, likely_room_type
 from more_agent.planners.task_goal import TaskGoal, task_goal
 from more_agent.records import LLMUsage
@@ -376,25 +376,18 @@ class GroundedPlanner:
     def _run(self, action: HighLevelAction) -> ActionResult:
         step, body, graph = self._step, self.body, self._graph()
         if action.name == DONE or step is None:
-            return ActionResult(ok=True, reason=None, feedback="done")
+            return run_skill(body, graph, DONE, None)
+        held = graph.held_object
+        target = graph.objects[step.target] if step.target is not None else Area(action.arguments[0], step.region)
+        result = run_skill(body, graph, action.name, target)
         if action.name == "explore":
             assert step.region is not None
-            result = explore(body, graph, step.region, action.arguments[0])
             self.explored[step.region] += 1
-        elif step.target is None:
-            held = graph.held_object
-            result = place_on_floor(body, graph, step.region, action.arguments[0])
-            if result.ok and held is not None:
-                region = step.region or graph.robot.region_id
-                self.relation[held.label] = ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
-        else:
-            target = graph.objects[step.target]
-            if action.name == "navigate":
-                result = navigate(body, graph, target)
-            else:
-                result = go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
-            if result.ok and action.name == "go_to_and_open":
-                self.looked_into.add(step.target)
+        elif step.target is None and result.ok and held is not None:  # put on a floor
+            region = step.region or graph.robot.region_id
+            self.relation[held.label] = ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
+        elif result.ok and action.name == "go_to_and_open":
+            self.looked_into.add(step.target)
         if not result.ok:
             self._failed(action, step, result)
         return result

@@ -30,7 +30,6 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.llm import (
-    DEFAULT_SKILLS,
     FilterAnswer,
     InvalidAnswer,
     LLMClient,
@@ -54,15 +53,16 @@ from more_agent.llm import (
 from more_agent.llm.completion import Completion
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.base import EpisodeContext, HighLevelAction
 from more_agent.planners.exchanges import Exchange, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
-from more_agent.planners.policies import MANIPULATION_SKILLS, Embodiment, PolicyConfig, explore, go_to_and, navigate
-from more_agent.planners.policies.skills import pick_target, place_on_floor, without_visited_frontiers
+from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
+from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.skills import SKILLS
 from more_agent.viz.graph_plot import save_step_graph
 
 log = logging.getLogger(__name__)
@@ -212,7 +212,7 @@ class LLMPlanner:
         try:
             answer = ask_validated(
                 self.clients.plan, messages, PlanAnswer,
-                lambda a: parse_plan_answer(a, DEFAULT_SKILLS, rooms, objects),
+                lambda a: parse_plan_answer(a, SKILLS, rooms, objects),
                 max_reasks=self.config.max_reasks, purpose="plan",
             )
         except InvalidAnswer as e:
@@ -303,23 +303,19 @@ class LLMPlanner:
 
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
-        if action.name == DONE:
-            return ActionResult(ok=True, reason=None, feedback="done")
         if action.name == INVALID:
             return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
         body, graph, view = self._body(), self._graph(), self._view()
+        if not action.arguments:  # done
+            return run_skill(body, graph, action.name, None)
         room = action.arguments[0]
-        if action.name == "explore":
-            return explore(body, graph, view.room(room).region_id, room)
-        if action.arguments[1] == FLOOR and not view.resolve(room, FLOOR):
-            return _floor_action(body, graph, action, view.room(room).region_id, room)
+        if len(action.arguments) == 1 or (action.arguments[1] == FLOOR and not view.resolve(room, FLOOR)):
+            return run_skill(body, graph, action.name, Area(room, view.room(room).region_id))
         target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
         if target is None:
             return ActionResult(ok=False, reason=FailureReason.UNKNOWN_OBJECT,
                                 feedback=f"unknown object {action.arguments[1]}")
-        if action.name == "navigate":
-            return navigate(body, graph, target)
-        return go_to_and(body, graph, MANIPULATION_SKILLS[action.name], target)
+        return run_skill(body, graph, action.name, target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def _add(self, completions: Sequence[Completion]) -> None:
@@ -342,13 +338,6 @@ class LLMPlanner:
         if self.view is None:
             raise RuntimeError("observe() must be called before decide() / execute()")
         return self.view
-
-
-def _floor_action(body: Embodiment, graph: SceneGraph, action: HighLevelAction, region_id: str, room: str) -> ActionResult:
-    """A skill on a room's floor: only placing on it is possible."""
-    if action.name == "go_to_and_place_ontop":
-        return place_on_floor(body, graph, region_id, room)
-    return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"cannot {action.name} the floor of {room}")
 
 
 def make_more(llm: str | None) -> LLMPlanner:

@@ -25,19 +25,14 @@ from dataclasses import replace
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
 from more_agent.planners.policies import Embodiment
 from more_agent.records import LLMUsage
-from more_agent.sim.actions import (
-    ActionResult,
-    FailureReason,
-    approach_rounds,
-    distance_to_footprint,
-    go_to_and,
-    navigate_to,
-)
+from more_agent.sim.actions import ActionResult, FailureReason, approach_rounds, distance_to_footprint
+from more_agent.sim.env import ACTION_TYPES
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import REARRANGE_PREDICATES
 from more_agent.sim.world import World, WorldObject
+from more_agent.skills import skill_named
 from more_agent.viz.graph_plot import save_step_graph
 
 ORACLE_PREDICATES = REARRANGE_PREDICATES
@@ -335,17 +330,12 @@ class OraclePlanner:
         return result
 
     def _run(self, action: HighLevelAction) -> ActionResult:
-        """Run a subpolicy through the magic actions; remember failures and blocking doors."""
+        """Run a subpolicy as one magic action of the env; remember failures and blocking doors."""
         world = self._world
-        if action.name == DONE:
-            return ActionResult(ok=True, reason=None, feedback="episode ended")
+        result = self._body.act(world_action(action.name), *action.arguments)
+        if action.is_done:
+            return result
         (arg,) = action.arguments
-        if action.name == "navigate_to":
-            result = navigate_to(world, arg)
-        elif action.name.startswith("go_to_and_"):
-            result = go_to_and(world, action.name.removeprefix("go_to_and_"), arg)
-        else:
-            raise ValueError(f"oracle cannot execute {action.name!r}")
         if result.ok:
             self._observed.add(arg)
             if action.name == "go_to_and_open":
@@ -360,3 +350,14 @@ class OraclePlanner:
             if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR:
                 self._door = result.blocking
         return result
+
+
+def world_action(name: str) -> str:
+    """The env action type that runs an oracle action: ``navigate_to`` and ``done`` are action types
+    themselves, a skill (``go_to_and_grasp``) runs its world action from the skill table."""
+    if name in ACTION_TYPES:
+        return name
+    action = skill_named(name).world_action
+    if action is None:
+        raise ValueError(f"oracle cannot execute {name!r}: it acts on the world, not on a map")
+    return action

@@ -18,14 +18,11 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.errors import unknown_name_error
-from more_agent.llm.answers import DEFAULT_SKILLS, Skill
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.errors import InvalidAnswer
 from more_agent.llm.images import image_part, text_part
 from more_agent.llm.prompts import history_text, render_prompt, skill_api_text
-
-VLM_SKILLS: tuple[Skill, ...] = tuple(Skill(s.name, (), s.description.replace(" in the room", "")) for s in DEFAULT_SKILLS)
-"""The paper's subpolicies without parameters: the VLM names the skill, later questions pick its target."""
+from more_agent.skills import SKILLS
 
 
 class _Answer(BaseModel):
@@ -95,7 +92,7 @@ def step_messages(
 ) -> list[ChatMessage]:
     """The step decision: task, annotated current view and its marked objects, memories, skills."""
     messages = render_prompt(
-        "bumble_plan", task=task, skills=skill_api_text(VLM_SKILLS), objects=object_list(objects, numbered=True),
+        "bumble_plan", task=task, skills=skill_api_text(SKILLS, vlm=True), objects=object_list(objects, numbered=True),
         held_object=held or "nothing", history=history_text(history), feedback=feedback or "none",
     )
     return with_pictures(messages, [view])
@@ -119,7 +116,7 @@ def parse_step(answer: str | Mapping[str, Any]) -> tuple[str, str]:
         raise InvalidAnswer("no JSON object with 'subtask' and 'skill' found")
     skill = str(answer.get("skill", "")).strip().lower().replace(" ", "_").removesuffix("()")
     subtask = str(answer.get("subtask", "")).strip()
-    names = [s.name for s in VLM_SKILLS]
+    names = [s.name for s in SKILLS]
     if skill not in names:
         raise InvalidAnswer(f"{unknown_name_error('skill', skill, names)}; skills: {', '.join(names)}")
     if not subtask and skill != "done":

@@ -333,7 +333,8 @@ MANIPULATIONS: dict[str, Callable[[World, str], ActionResult]] = {
     "place_inside": place_inside,
     "place_ontop": place_ontop,
 }
-"""Magic manipulations by name; each takes the world and one object name."""
+"""The world's binding of the skill table's manipulations (:data:`more_agent.skills.MANIPULATION_VERBS`)
+to the functions that carry them out; each takes the world and one object name."""
 
 
 def go_to_and(world: World, verb: str, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:

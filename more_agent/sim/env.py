@@ -7,7 +7,13 @@ metres with **0 where invalid** (nothing hit or beyond 5 m; Gymnasium spaces can
 T_world_cam; ``intrinsics`` K; ``robot_pose`` (x, y, yaw); ``held`` the held item's instance id (0:
 empty hand).
 
-Action (a ``spaces.Dict``): ``type`` indexes ``ACTION_TYPES``; ``amount`` is metres for
+With ``sensors=False`` nothing is rendered: the observation holds only ``robot_pose`` and ``held``,
+and reset makes no initial turn. That is how the agent's embodiment
+(:class:`more_agent.planners.policies.Embodiment`) steps the world: it senses with its own camera
+when it chooses to, not after every 7.5 cm move.
+
+Action (a ``spaces.Dict``): ``type`` indexes ``ACTION_TYPES`` (the low-level moves, then the world
+actions of the skill table :data:`more_agent.skills.SKILLS`); ``amount`` is metres for
 ``move_forward`` (at most 0.075) and radians for the turns (at most 35 degrees; more is clipped and
 reported); ``target`` names an object by world name ('fridge_0') or label ('fridge A') for the magic
 actions. Manipulations first drive next to a target out of reach (the paper's go-to-and-act
@@ -15,14 +21,21 @@ subpolicies). ``make_action`` builds actions with the paper's default amounts. A
 unknown object is reported in ``info`` (``action_ok`` False, ``reason``, ``feedback``) and the
 episode goes on.
 
-``reset(seed=..., options={"task": ..., "scene": ..., "instance": TaskInstance, "task_seed": int})``:
-an injected instance is used as is; a task is instantiated (seed ``task_seed``, else drawn from
+``reset(seed=..., options={"task": ..., "scene": ..., "instance": TaskInstance, "task_seed": int,
+"world": World})``: an injected instance is used as is; so is an injected world (no task, the
+robot where it stands); a task is instantiated (seed ``task_seed``, else drawn from
 ``np_random``); a scene alone (default ``DEFAULT_SCENE``) gets no task and a start pose drawn from
-``np_random`` among the free cells of the navigation grid. Every episode starts with a full turn
-in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
+``np_random`` among the free cells of the navigation grid. With sensors every episode starts with
+a full turn in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
 view after it. ``info["path_frames"]`` likewise holds views along a magic navigation's path every
 ``path_frame_spacing_m``. ``terminated`` when ``done`` is taken; ``truncated`` after ``max_steps``
-steps. The reward is the change in goal progress (0 without a task).
+steps (never when ``max_steps`` is None). The reward is the change in goal progress (0 without a task).
+
+``info`` carries what the agent could know: the action's outcome and feedback, step counts, the
+path of a magic navigation, the closed door that blocked it (``blocking``) and the instance table
+of the view. Goal state is privileged: only an
+env built with ``privileged_info=True`` adds ``info["goal_status"]`` (a ``GoalStatus``: per-conjunct
+status, ``all_met``, ``progress``), for evaluation code and tests, never for a planner under test.
 """
 
 from __future__ import annotations
@@ -44,13 +57,16 @@ from more_agent.sim.navgrid import free_cells, nav_grid
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.world import World
+from more_agent.skills import SKILLS
 
 ENV_ID = "MoreAgent/Behavior-v0"
 
-ACTION_TYPES: tuple[str, ...] = (
-    "move_forward", "turn_left", "turn_right", "navigate_to", "open", "close", "grasp", "place_inside", "place_ontop", "done",
-)
-"""Names of the action types, indexed by the action's ``type``."""
+MOTIONS: tuple[str, ...] = ("move_forward", "turn_left", "turn_right")
+"""The low-level moves (paper S.3)."""
+
+ACTION_TYPES: tuple[str, ...] = MOTIONS + tuple(s.world_action for s in SKILLS if s.world_action is not None)
+"""Names of the action types, indexed by the action's ``type``: the low-level moves, then the world
+actions of the skill table (navigate_to, open, close, grasp, place_inside, place_ontop, done)."""
 
 DEFAULT_SCENE = "Rs_int"
 """Scene used when neither the constructor nor reset options name one (no task)."""
@@ -83,28 +99,35 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
 
     def __init__(self, task: str | None = None, scene: str | None = None, *, render_mode: str | None = None,
-                 max_steps: int = 1000, camera: Camera | None = None, path_frame_spacing_m: float = 1.0) -> None:
+                 max_steps: int | None = 1000, camera: Camera | None = None, path_frame_spacing_m: float = 1.0,
+                 sensors: bool = True, privileged_info: bool = False) -> None:
         """``task`` / ``scene``: what reset loads when its options name nothing; ``max_steps``: truncation
-        limit in env steps; ``path_frame_spacing_m``: spacing of the views along a navigation path (0: none)."""
+        limit in env steps (None: none); ``path_frame_spacing_m``: spacing of the views along a
+        navigation path (0: none); ``sensors``: render observations; ``privileged_info``: add the goal
+        status to ``info``."""
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unsupported render_mode {render_mode!r}; supported: {self.metadata['render_modes']}")
         self.render_mode = render_mode
         self.task, self.scene, self.max_steps = task, scene, max_steps
         self.path_frame_spacing_m = path_frame_spacing_m
+        self.sensors, self.privileged_info = sensors, privileged_info
         self.renderer = Renderer(camera)
         cam = self.renderer.camera
         hw = (cam.height, cam.width)
         ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
-        self.observation_space = spaces.Dict({
+        state = {
+            "robot_pose": spaces.Box(np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
+                                     np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]), (3,), np.float64),
+            "held": spaces.Box(0, _INT32_MAX, (), np.int32),
+        }
+        self.observation_space = spaces.Dict(state if not sensors else {
             "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
             "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
             "semantic": ids,
             "instance": ids,
             "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
             "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
-            "robot_pose": spaces.Box(np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
-                                     np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]), (3,), np.float64),
-            "held": spaces.Box(0, _INT32_MAX, (), np.int32),
+            **state,
         })
         self.action_space = spaces.Dict({
             "type": spaces.Discrete(len(ACTION_TYPES)),
@@ -123,31 +146,27 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
         options = options or {}
-        self.instance = self._load(options)
+        world = options.get("world")
+        self.instance = self._load(options) if world is None else None
         if self.instance is not None:
             self.world = self.instance.world
             self._goal = GoalChecker(self.instance)
+        elif world is not None:
+            self.world, self._goal = world, None
         else:
             self.world = World.from_scene(get_scene(options.get("scene") or self.scene or DEFAULT_SCENE, 0))
             self._goal = None
             self._spawn()
         self._steps, self._low_level_steps = 0, 0
-        start = self.world.robot
-        x, y, yaw = start.x, start.y, start.yaw
-        turn_frames = [self._record()]
-        angles = motion.full_turn_angles()
-        for angle in angles[:-1]:
-            motion.turn(self.world, angle)
-            turn_frames.append(self._record())
-        self.world.set_robot_pose(x, y, yaw)  # the last turn closes the circle (without rounding drift)
-        self._low_level_steps = len(angles)
+        turn_frames = self._turn_around() if self.sensors else [self._record()]
         status = self._status()
         self._progress = status.progress if status is not None else 0.0
         obs = {k: v.copy() for k, v in turn_frames[0]["obs"].items()}  # the turn ends where it began
-        self._last_rgb = obs["rgb"]
-        info = self._info(status, "reset", True, None, "turned around in place", len(angles), [], turn_frames[0]["instances"])
+        self._last_rgb = obs.get("rgb")
+        feedback = "turned around in place" if self.sensors else "ready"
+        info = self._info(status, "reset", True, None, feedback, self._low_level_steps, [], turn_frames[0]["instances"])
         info.update(
-            turn_frames=turn_frames, path_frames=[], class_names=list(self.world.class_names),
+            turn_frames=turn_frames if self.sensors else [], path_frames=[], class_names=list(self.world.class_names),
             task=self.instance.task if self.instance else None,
             task_description=self.instance.description if self.instance else None,
         )
@@ -159,30 +178,43 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         self._steps += 1
         kind, amount, target, error = _parse(action)
         path: list[tuple[float, float]] = []
+        blocking = None
         if error is not None:
             ok, reason, feedback, steps = False, "invalid_action", error, 0
         elif kind == "done":
             ok, reason, feedback, steps = True, None, "episode ended", 0
-        elif kind in ("move_forward", "turn_left", "turn_right"):
+        elif kind in MOTIONS:
             res = self._move(kind, amount)
             ok, reason, feedback, steps = res.ok, res.reason.value if res.reason else None, res.feedback, res.low_level_steps
         else:
-            name = self._resolve(target)
+            name = self.resolve(target)
             if name is None:
                 ok, reason, feedback, steps = False, "unknown_object", f"unknown object {target!r}", 0
             else:
-                res = actions.navigate_to(self.world, name) if kind == "navigate_to" else actions.go_to_and(self.world, kind, name)
-                ok, reason, feedback, steps, path = res.ok, res.reason.value if res.reason else None, res.feedback, res.low_level_steps, list(res.path)
+                act = actions.navigate_to(self.world, name) if kind == "navigate_to" else actions.go_to_and(self.world, kind, name)
+                ok, reason, feedback, steps = act.ok, act.reason.value if act.reason else None, act.feedback, act.low_level_steps
+                path, blocking = list(act.path), act.blocking
         self._low_level_steps += steps
         record = self._record()
         status = self._status()
         progress = status.progress if status is not None else 0.0
         reward, self._progress = progress - self._progress, progress
-        self._last_rgb = record["obs"]["rgb"]
+        self._last_rgb = record["obs"].get("rgb")
         info = self._info(status, kind or "invalid", ok, reason, feedback, steps, path, record["instances"])
-        info["path_frames"] = self._path_frames(path)
-        truncated = self._steps >= self.max_steps and kind != "done"
+        info.update(blocking=blocking, path_frames=self._path_frames(path))
+        truncated = self.max_steps is not None and self._steps >= self.max_steps and kind != "done"
         return record["obs"], float(reward), kind == "done", truncated, info
+
+    def resolve(self, target: str) -> str | None:
+        """World name of the object a target names: its name, or its label (exactly, else ignoring case)."""
+        if self.world is None:
+            raise RuntimeError("call reset() before resolve()")
+        key = target.strip()
+        if key in self.world.objects:
+            return key
+        obj = self.world.by_label(key) or next(
+            (o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None)
+        return obj.name if obj is not None else None
 
     def render(self) -> np.ndarray | None:
         """The RGB frame of the latest observation (``render_mode="rgb_array"``)."""
@@ -213,6 +245,20 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         x, y = grid.centre(cells[int(self.np_random.integers(len(cells)))])
         self.world.set_robot_pose(x, y, float(self.np_random.uniform(-math.pi, math.pi)))
 
+    def _turn_around(self) -> list[dict[str, Any]]:
+        """The full turn in place every episode starts with (S.3): the records of its distinct views."""
+        assert self.world is not None
+        start = self.world.robot
+        x, y, yaw = start.x, start.y, start.yaw
+        turn_frames = [self._record()]
+        angles = motion.full_turn_angles()
+        for angle in angles[:-1]:
+            motion.turn(self.world, angle)
+            turn_frames.append(self._record())
+        self.world.set_robot_pose(x, y, yaw)  # the last turn closes the circle (without rounding drift)
+        self._low_level_steps = len(angles)
+        return turn_frames
+
     def _move(self, kind: str, amount: float) -> motion.MotionResult:
         assert self.world is not None
         if kind == "move_forward":
@@ -221,35 +267,29 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             return motion.MotionResult(False, motion.MotionFailure.INVALID_AMOUNT, f"turn amount must be >= 0, got {amount}", 0.0)
         return motion.turn(self.world, amount if kind == "turn_left" else -amount)
 
-    def _resolve(self, target: str) -> str | None:
-        """World name of the object a target names (its name, or its label, case-insensitively)."""
-        assert self.world is not None
-        key = target.strip()
-        if key in self.world.objects:
-            return key
-        obj = next((o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None)
-        return obj.name if obj is not None else None
-
     def _status(self) -> GoalStatus | None:
         return self._goal.check(self.world) if self._goal is not None else None
 
     def _record(self, pose: tuple[float, float, float] | None = None) -> dict[str, Any]:
-        """{"obs": observation, "instances": instance table} at the robot's pose or at ``pose`` (x, y, yaw)."""
+        """{"obs": observation, "instances": instance table} at the robot's pose or at ``pose`` (x, y, yaw);
+        without sensors only the robot's state and no instances."""
         assert self.world is not None
         r = self.world.robot
         x, y, yaw = pose if pose is not None else (r.x, r.y, r.yaw)
-        frame = self.renderer.render_at(self.world, self.renderer.camera.pose(x, y, yaw))
         held = self.world.objects[r.held].instance_id if r.held is not None else 0
+        state = {"robot_pose": np.array([x, y, yaw], dtype=np.float64), "held": np.array(held, dtype=np.int32)}
+        if not self.sensors:
+            return {"obs": state, "instances": {}}
+        frame = self.renderer.render_at(self.world, self.renderer.camera.pose(x, y, yaw))
         obs = {
             "rgb": frame.rgb, "depth": np.nan_to_num(frame.depth, nan=0.0), "semantic": frame.semantic,
-            "instance": frame.instance, "pose": frame.T_world_cam, "intrinsics": frame.K,
-            "robot_pose": np.array([x, y, yaw], dtype=np.float64), "held": np.array(held, dtype=np.int32),
+            "instance": frame.instance, "pose": frame.T_world_cam, "intrinsics": frame.K, **state,
         }
         return {"obs": obs, "instances": instance_table(self.world, frame.instance)}
 
     def _path_frames(self, path: list[tuple[float, float]]) -> list[dict[str, Any]]:
         """Views every ``path_frame_spacing_m`` along a path, facing along it (none when disabled)."""
-        if self.path_frame_spacing_m <= 0 or len(path) < 2:
+        if not self.sensors or self.path_frame_spacing_m <= 0 or len(path) < 2:
             return []
         out = []
         for (x0, y0), (x1, y1) in zip(path[:-1], path[1:], strict=True):
@@ -261,11 +301,14 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
 
     def _info(self, status: GoalStatus | None, kind: str, ok: bool, reason: str | None, feedback: str, steps: int,
               path: list[tuple[float, float]], instances: dict[int, dict[str, Any]]) -> dict[str, Any]:
-        return {
+        info = {
             "action": kind, "action_ok": ok, "reason": reason, "feedback": feedback,
             "low_level_steps": steps, "total_low_level_steps": self._low_level_steps, "steps": self._steps,
-            "path": [tuple(map(float, p)) for p in path], "instances": instances, "goal_status": status,
+            "path": [tuple(map(float, p)) for p in path], "instances": instances,
         }
+        if self.privileged_info:
+            info["goal_status"] = status
+        return info
 
 
 def _parse(action: Any) -> tuple[str | None, float, str, str | None]:

@@ -7,7 +7,6 @@ import json
 import pytest
 
 from more_agent.llm import (
-    DEFAULT_SKILLS,
     ChatMessage,
     InvalidAnswer,
     LLMBadRequest,
@@ -20,6 +19,7 @@ from more_agent.llm import (
 )
 from more_agent.llm.errors import OversizeAnswer
 from more_agent.llm.limits import MAX_ANSWER_CHARS, MAX_ECHO_CHARS, MAX_ERROR_CHARS, MAX_NAME_CHARS, clip
+from more_agent.skills import SKILLS
 from tests.fakes.openai_server import FakeOpenAIServer, Reply, Status
 
 MESSAGES = [ChatMessage(role="user", content="plan")]
@@ -28,7 +28,7 @@ HUGE = '{"reasoning": "' + "x" * 5_000_000 + '", "skill": "done", "arguments": [
 
 
 def _validate(answer: object) -> object:
-    return parse_plan_answer(answer, DEFAULT_SKILLS, ["kitchen_0"], ["apple_a"])  # type: ignore[arg-type]
+    return parse_plan_answer(answer, SKILLS, ["kitchen_0"], ["apple_a"])  # type: ignore[arg-type]
 
 
 def test_clip_is_bounded_and_idempotent() -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from more_agent.llm import (
-    DEFAULT_SKILLS,
     InvalidAnswer,
     ModelPrice,
     PlannedAction,
@@ -15,6 +14,7 @@ from more_agent.llm import (
     parse_room_label,
 )
 from more_agent.llm.usage import price_of
+from more_agent.skills import SKILLS
 
 ROOMS = ["kitchen_0", "living_room_0", "garden_0"]
 OBJECTS = ["fridge_a", "apple_a", "apple_b", "countertop_a", "sofa_a"]
@@ -22,7 +22,7 @@ SCENE = {"kitchen_0": ["fridge_a", "apple_a", "countertop_a"], "living_room_0": 
 
 
 def plan(answer: object) -> PlannedAction:
-    return parse_plan_answer(answer, DEFAULT_SKILLS, ROOMS, OBJECTS)  # type: ignore[arg-type]
+    return parse_plan_answer(answer, SKILLS, ROOMS, OBJECTS)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(

@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 import pytest
 
 from more_agent.llm import (
-    DEFAULT_SKILLS,
     InvalidAnswer,
     LLMConfig,
     PlanAnswer,
@@ -22,6 +21,7 @@ from more_agent.llm import (
     room_messages,
 )
 from more_agent.llm.prompts import PROMPT_NAMES, prompt_fields
+from more_agent.skills import SKILLS
 from tests.fakes.openai_server import FakeOpenAIServer
 
 
@@ -74,7 +74,7 @@ def test_message_builders_fill_the_paper_fields() -> None:
         history=[Action("go_to_and_open", ["kitchen_0", "fridge_a"], ok=False, feedback="hand is full")], feedback="hand is full",
     )
     system, user = planning[0]["content"], planning[1]["content"]
-    assert all(s.signature in system for s in DEFAULT_SKILLS)
+    assert all(s.signature in system for s in SKILLS)
     assert scene in user and "holding nothing" in user and "1. go_to_and_open(kitchen_0, fridge_a) -> failed: hand is full" in user
     assert "Last feedback: hand is full" in user
     assert scene in filter_messages("Put the apple in the fridge.", scene)[1]["content"]
@@ -86,7 +86,7 @@ def _reply(skill: str, *args: str) -> str:
 
 
 def _validate(answer: object) -> object:
-    return parse_plan_answer(answer, DEFAULT_SKILLS, ["kitchen_0"], ["apple_a", "fridge_a"])  # type: ignore[arg-type]
+    return parse_plan_answer(answer, SKILLS, ["kitchen_0"], ["apple_a", "fridge_a"])  # type: ignore[arg-type]
 
 
 def test_reask_feeds_back_the_reason_then_succeeds(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:

@@ -14,6 +14,7 @@ import more_agent.sim  # noqa: F401  (registers the environment)
 from more_agent.sim.env import ACTION_TYPES, ENV_ID, MoreAgentEnv, frame_from_observation, make_action
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World
 
 FIXTURES = Path(__file__).parent.parent / "fixtures"
 TINY = str(FIXTURES / "tiny_scene.json")
@@ -33,7 +34,7 @@ def test_passes_gymnasium_env_checker():
 
 def test_default_env_resets_without_options():
     obs, info = MoreAgentEnv().reset(seed=3)
-    assert obs in MoreAgentEnv().observation_space and info["task"] is None and info["goal_status"] is None
+    assert obs in MoreAgentEnv().observation_space and info["task"] is None and "goal_status" not in info
 
 
 def test_same_seed_same_frames(env):
@@ -100,7 +101,7 @@ def test_low_level_moves_done_and_truncation():
 
 def test_task_episode_reports_goal_progress_and_rewards_it():
     instance = instantiate_in_scene("putting_shopping_away", load_scene(FIXTURES / "tasks_kitchen_scene.json"), seed=0)
-    env = MoreAgentEnv()
+    env = MoreAgentEnv(privileged_info=True)
     _, info = env.reset(seed=0, options={"instance": instance})
     assert env.world is instance.world and info["goal_status"].progress == 0.0 and info["task_description"]
     beef = "pack__of__ground_beef_1"  # a world name: its label only exists once the robot has seen it
@@ -111,3 +112,28 @@ def test_task_episode_reports_goal_progress_and_rewards_it():
         rewards.append(reward)
     assert rewards == [0.0, 0.0, pytest.approx(0.2)] and info["goal_status"].progress == pytest.approx(0.2)
     assert info["low_level_steps"] > 1 and info["path_frames"] and len(info["path"]) >= 2
+
+
+def test_goal_state_is_privileged_but_the_reward_is_not():
+    instance = instantiate_in_scene("putting_shopping_away", load_scene(FIXTURES / "tasks_kitchen_scene.json"), seed=0)
+    env = MoreAgentEnv()
+    _, info = env.reset(seed=0, options={"instance": instance})
+    rewards = []
+    for action in (make_action("open", "fridge A"), make_action("grasp", "pack__of__ground_beef_1"),
+                   make_action("place_inside", "fridge_0")):
+        _, reward, _, _, info = env.step(action)
+        assert "goal_status" not in info
+        rewards.append(reward)
+    assert rewards == [0.0, 0.0, pytest.approx(0.2)]
+
+
+def test_without_sensors_an_injected_world_steps_unrendered_and_unturned():
+    world = World.from_scene(load_scene(TINY))
+    world.set_robot_pose(world.robot.x, world.robot.y, 0.0)
+    env = MoreAgentEnv(sensors=False, max_steps=None)
+    obs, info = env.reset(options={"world": world})
+    assert env.world is world and set(obs) == {"robot_pose", "held"} and obs in env.observation_space
+    assert info["turn_frames"] == [] and info["total_low_level_steps"] == 0
+    obs, _, _, truncated, info = env.step(make_action("turn_right", amount=0.25))
+    assert world.robot.yaw == pytest.approx(-0.25) and obs["robot_pose"][2] == pytest.approx(-0.25)
+    assert info["instances"] == {} and info["path_frames"] == [] and not truncated

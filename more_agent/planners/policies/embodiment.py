@@ -1,7 +1,9 @@
 """The robot as the subpolicies drive it: world, camera, scene-graph builder and step accounting.
 
-Every low-level action goes through :mod:`more_agent.sim.motion` (7.5 cm forward moves, turns of at
-most 35 degrees) and is counted; frames are rendered and fused into the
+The robot steps the world only through the Gymnasium env (:class:`more_agent.sim.env.MoreAgentEnv`,
+built without sensors, goal or privileged info): every low-level action (7.5 cm forward moves, turns
+of at most 35 degrees) and every magic action is one ``env.step``, and is counted. Frames are
+rendered by the robot's own camera and fused into the
 :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
 moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
 Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
@@ -12,14 +14,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
-from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult
-from more_agent.sim.motion import full_turn_angles, move_forward, turn
+from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
+from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
+from more_agent.sim.motion import full_turn_angles
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
@@ -53,7 +56,8 @@ class PolicyConfig(BaseModel):
 
 
 class Embodiment:
-    """World + renderer + scene-graph builder, with low-level step, trajectory and observation accounting."""
+    """World (stepped through the env) + renderer + scene-graph builder, with low-level step, trajectory
+    and observation accounting."""
 
     def __init__(
         self,
@@ -64,6 +68,8 @@ class Embodiment:
         renderer: Renderer | None = None,
     ) -> None:
         self.world = world
+        self.env = MoreAgentEnv(sensors=False, max_steps=None)
+        self.env.reset(options={"world": world})
         self.config = config or PolicyConfig()
         self.renderer = renderer or Renderer()
         self.builder = SceneGraphBuilder(world.class_names, mapping)
@@ -149,13 +155,33 @@ class Embodiment:
         """The scene graph of everything sensed so far, from the robot's position."""
         return self.builder.build(self.xy)
 
+    def act(self, kind: str, target: str = "") -> ActionResult:
+        """One magic action of the env (a world action of the skill table: ``navigate_to``, ``grasp``,
+        ..., ``done``) on ``target``, a world name or label. Its steps and path are not accounted here
+        (the oracle reports them itself; the subpolicies pass them to :meth:`record_jump`)."""
+        info = self._step(kind, target=target)
+        reason = FailureReason(info["reason"]) if info["reason"] else None
+        return ActionResult(ok=info["action_ok"], reason=reason, feedback=info["feedback"],
+                            low_level_steps=info["low_level_steps"], path=info["path"], blocking=info["blocking"])
+
+    def _step(self, kind: str, *, target: str = "", amount: float | None = None) -> dict[str, Any]:
+        """``env.step`` of action type ``kind`` (:data:`~more_agent.sim.env.ACTION_TYPES`); its info."""
+        action: dict[str, object] = {"type": ACTION_TYPES.index(kind), "target": target}
+        if amount is not None:
+            action["amount"] = amount  # a Python float: the env keeps its full precision
+        return self.env.step(action)[-1]
+
+    def _turn(self, angle: float) -> None:
+        """One low-level turn by ``angle`` radians (positive: left)."""
+        self._step("turn_left" if angle >= 0 else "turn_right", amount=abs(angle))
+        self.low_level_steps += 1
+
     def turn_by(self, angle: float) -> None:
         """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense."""
         angle = math.atan2(math.sin(angle), math.cos(angle))
         n = math.ceil(abs(angle) / MAX_TURN_RAD - 1e-9)
         for _ in range(n):
-            turn(self.world, angle / n)
-            self.low_level_steps += 1
+            self._turn(angle / n)
         if n:
             self.sense()
 
@@ -168,8 +194,7 @@ class Embodiment:
     def look_around(self) -> None:
         """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
         for angle in full_turn_angles():
-            turn(self.world, angle)
-            self.low_level_steps += 1
+            self._turn(angle)
             self.sense()
 
     def follow(self, waypoints: Sequence[XY]) -> bool:
@@ -179,15 +204,16 @@ class Embodiment:
             self.face(target)
             remaining = math.dist(self.xy, target)
             while remaining > 1e-6:
-                result = move_forward(self.world, min(FORWARD_STEP_M, remaining))
+                distance = min(FORWARD_STEP_M, remaining)
+                ok = self._step("move_forward", amount=distance)["action_ok"]
                 self.low_level_steps += 1
-                if not result.ok:
+                if not ok:
                     reach = FORWARD_STEP_M + DEFAULT_NAV.robot_radius_m
                     yaw = self.world.robot.yaw
                     self.bumps.append((self.xy[0] + reach * math.cos(yaw), self.xy[1] + reach * math.sin(yaw)))
                     self.sense()
                     return False
-                remaining -= result.applied
+                remaining -= distance  # a move below the full step is made whole or not at all
                 moved += 1
                 self.trajectory.append(self.xy)
                 if moved % self.config.sense_every_steps == 0:

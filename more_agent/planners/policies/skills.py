@@ -7,30 +7,26 @@ a success flag plus a simple reason ("hand is full", "must open fridge A first",
 in kitchen_0", "unknown object"). ``go_to_and_<verb>`` drives to the Voronoi node closest to the
 object, then runs the magic action on the world object the label resolves to; that action makes
 the final approach on a circle around the object when the node is out of reach (paper S.3).
+
+Planners run a decided skill with :func:`run_skill`, which looks the skill up in the table
+(:data:`more_agent.skills.SKILLS`) and calls the subpolicy bound to it in :data:`SUBPOLICIES`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim import actions
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.world import floor_name
+from more_agent.skills import Skill, Subpolicy, skill_named
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
-
-MANIPULATION_SKILLS: dict[str, str] = {
-    "go_to_and_open": "open",
-    "go_to_and_close": "close",
-    "go_to_and_grasp": "grasp",
-    "go_to_and_place_inside": "place_inside",
-    "go_to_and_place_ontop": "place_ontop",
-}
-"""Skill name -> magic action verb of :data:`more_agent.sim.actions.MANIPULATIONS`."""
 
 
 def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
@@ -107,18 +103,17 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
 def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode) -> ActionResult:
     """navigate() unless the object is within reach, then the magic action on the world object."""
     start = body.low_level_steps
-    world = body.world
-    obj = world.by_label(target.label)
-    if obj is None:
+    name = body.env.resolve(target.label)
+    if name is None:
         return _fail(FailureReason.UNKNOWN_OBJECT, f"unknown object {target.label}")
-    if not target.held and actions.distance_to_footprint(world, obj.name) > actions.REACH_M:
+    if not target.held and actions.distance_to_footprint(body.world, name) > actions.REACH_M:
         moved = navigate(body, graph, target)
         if not moved.ok:
             return moved
-    result = actions.go_to_and(world, verb, obj.name)
+    result = body.act(verb, name)  # the env's go-to-and-act: the final approach when still out of reach
     body.record_jump(result.path, result.low_level_steps)
     if result.ok:
-        body.sense(acted_on=(obj.name,))  # what opening / placing revealed; the new state even out of view
+        body.sense(acted_on=(name,))  # what opening / placing revealed; the new state even out of view
     return ActionResult(
         ok=result.ok, reason=result.reason, feedback=result.feedback,
         low_level_steps=body.low_level_steps - start, blocking=result.blocking,
@@ -155,7 +150,7 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     room_id = world.room_at(*body.xy)
     if room_id is None:
         return _fail(FailureReason.INVALID_TARGET, "no floor here", body.low_level_steps - start)
-    result = actions.place_ontop(world, floor_name(room_id))
+    result = body.act("place_ontop", floor_name(room_id))
     body.record_jump(result.path, result.low_level_steps)
     if result.ok:
         body.sense()  # the hand is empty now: without a frame the graph would still show the item held
@@ -172,3 +167,73 @@ def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m
         for rid, r in graph.regions.items()
     }
     return graph.model_copy(update={"regions": regions})
+
+
+# -- dispatch through the skill table -----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Area:
+    """What an area skill acts on: a region's frontiers (explore) or floor (placing on it)."""
+
+    name: str
+    """How feedback names it: the room name the planner used."""
+    region_id: str | None = None
+    """The region; None for the floor where the robot stands."""
+    frontiers: tuple[XY, ...] | None = None
+    """The frontiers to explore instead of the region's own (BUMBLE explores those a chosen frame shows)."""
+
+
+Target = ObjectNode | Area | None
+"""What a skill acts on: a scene-graph object, an area, or nothing (done)."""
+
+SubpolicyFn = Callable[[Embodiment, SceneGraph, Skill, Target], ActionResult]
+"""A subpolicy as the table dispatches to it: the robot, the step's scene graph, the skill, its target."""
+
+
+def _explore(body: Embodiment, graph: SceneGraph, skill: Skill, target: Target) -> ActionResult:
+    if not isinstance(target, Area):
+        return _fail(FailureReason.INVALID_TARGET, f"{skill.name} takes a room")
+    if target.frontiers is not None:
+        return explore_frontiers(body, graph, target.frontiers, target.name)
+    if target.region_id is None:
+        return _fail(FailureReason.INVALID_TARGET, f"{skill.name} takes a room")
+    return explore(body, graph, target.region_id, target.name)
+
+
+def _navigate(body: Embodiment, graph: SceneGraph, skill: Skill, target: Target) -> ActionResult:
+    if isinstance(target, ObjectNode):
+        return navigate(body, graph, target)
+    return _cannot(skill, target)
+
+
+def _go_to_and(body: Embodiment, graph: SceneGraph, skill: Skill, target: Target) -> ActionResult:
+    assert skill.world_action is not None
+    if isinstance(target, ObjectNode):
+        return go_to_and(body, graph, skill.world_action, target)
+    if isinstance(target, Area) and skill.world_action == "place_ontop":
+        return place_on_floor(body, graph, target.region_id, target.name)
+    return _cannot(skill, target)
+
+
+def _done(body: Embodiment, graph: SceneGraph, skill: Skill, target: Target) -> ActionResult:
+    return ActionResult(ok=True, reason=None, feedback="done")
+
+
+def _cannot(skill: Skill, target: Target) -> ActionResult:
+    """The failure of an object skill given an area (only placing on a floor is possible) or nothing."""
+    where = f"the floor of {target.name}" if isinstance(target, Area) else "nothing"
+    return _fail(FailureReason.INVALID_TARGET, f"cannot {skill.name} {where}")
+
+
+SUBPOLICIES: dict[Subpolicy, SubpolicyFn] = {
+    "explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done,
+}
+"""The planners' binding of the skill table's subpolicies (:attr:`more_agent.skills.Skill.subpolicy`)
+to the functions that run them."""
+
+
+def run_skill(body: Embodiment, graph: SceneGraph, name: str, target: Target) -> ActionResult:
+    """Run the skill ``name`` of the table on ``target`` through its subpolicy."""
+    skill = skill_named(name)
+    return SUBPOLICIES[skill.subpolicy](body, graph, skill, target)
