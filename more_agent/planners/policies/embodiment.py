@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -23,9 +23,6 @@ from more_agent.sim.motion import full_turn_angles, move_forward, turn
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
-
-if TYPE_CHECKING:
-    from more_agent.planners.base import EpisodeContext
 
 
 class PolicyConfig(BaseModel):
@@ -62,6 +59,7 @@ class Embodiment:
         config: PolicyConfig | None = None,
         mapping: MappingConfig | None = None,
         renderer: Renderer | None = None,
+        on_frame: Callable[[Frame], None] | None = None,
     ) -> None:
         self.world = world
         self.config = config or PolicyConfig()
@@ -75,22 +73,9 @@ class Embodiment:
         self._reported_steps, self._reported_path = 0, 1
         self.bumps: list[XY] = []
         """Where blocked moves met something (just ahead of the base): obstacles on the robot's map."""
-        self.on_frame: Callable[[Frame], None] | None = None
+        self.on_frame = on_frame
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
-
-    @classmethod
-    def for_episode(
-        cls, context: EpisodeContext, *, config: PolicyConfig | None = None, mapping: MappingConfig | None = None
-    ) -> Embodiment:
-        """The robot in the episode's world; with ``context.save_frames`` every rendered frame is written
-        under ``out_dir/frames``."""
-        body = cls(context.instance.world, config=config, mapping=mapping)
-        if context.save_frames and context.out_dir is not None:
-            from more_agent.viz.frames import FRAMES_DIR, FrameWriter  # lazy: matplotlib only when writing frames
-
-            body.on_frame = FrameWriter(context.out_dir / FRAMES_DIR, body.world.class_names)
-        return body
 
     @property
     def xy(self) -> XY:
@@ -197,7 +182,11 @@ class Embodiment:
 
     def record_jump(self, path: Sequence[XY], steps: int) -> None:
         """Account for a motion a magic action made (its path and low-level steps), then sense."""
-        self.low_level_steps += steps
-        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
+        self.add_motion(path, steps)
         if path:
             self.sense()
+
+    def add_motion(self, path: Sequence[XY], steps: int) -> None:
+        """Count a motion made by a magic action (its path, start included, and low-level steps) without sensing."""
+        self.low_level_steps += steps
+        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
