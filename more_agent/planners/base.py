@@ -4,9 +4,10 @@ One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``Hig
 ``done``) and ``execute(action)`` (act: run it in the world, get an ``ActionResult``). The runner
 times the three phases, counts steps, reads the step's motion from the planner's robot
 (``body``), checks the goal and hands the planner's ``step_trace()`` to the episode folder; a
-planner never writes files, and never ends the episode itself except by deciding ``done``. Planners are built by name from the registry: ``make_planner('oracle')``.
-Built-in planners are listed by dotted path so that importing this module stays light; other
-code may add its own with ``register_planner``.
+planner never writes files, and never ends the episode itself except by deciding ``done``.
+Planners are built by name from the registry: ``make_planner('oracle')``. Built-in planners are
+listed by dotted path so that importing this module stays light; other code may add its own with
+``register_planner``.
 """
 
 from __future__ import annotations

@@ -23,8 +23,8 @@ from collections import Counter
 
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.policies import Embodiment
-from more_agent.scene_graph import SceneGraph
 from more_agent.records import LLMUsage
+from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import (
     ActionResult,
     FailureReason,
