@@ -137,13 +137,13 @@ def run_task(task: str, client: MeasuredClient, steps: int, seed: int) -> dict[s
     planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
     step_s, cpu_s, llm_s = [], [], []
     for _ in range(steps):
-        t0, c0, waited = time.perf_counter(), time.process_time(), planner.llm_seconds
+        t0, c0, waited = time.perf_counter(), time.process_time(), planner.llm_usage().seconds
         planner.observe()
         action = planner.decide()
         planner.execute(action)
         step_s.append(time.perf_counter() - t0)
         cpu_s.append(time.process_time() - c0)
-        llm_s.append(planner.llm_seconds - waited)
+        llm_s.append(planner.llm_usage().seconds - waited)
         if action.is_done:
             break
     calls = client.calls[first_call:]

@@ -149,21 +149,22 @@ def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True) -> dic
     planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
     rows = []
     for _ in range(steps):
-        calls_before = planner.usage.calls
+        calls_before = planner.llm_usage().calls
         t0 = time.perf_counter()
         planner.observe()
         action = planner.decide()
         t1 = time.perf_counter()
-        view, trace = planner.view, planner.trace
-        assert view is not None and trace is not None
+        view, planning = planner.view, planner.planning_view
+        assert view is not None and planning is not None
+        scene_text, planning_text = view.text(), planning.text()
         plan_kw = dict(task=planner.task, robot_room=view.robot_room, held_object=view.held, history=planner.history,
                        feedback=planner.feedback)
         rows.append({
-            "plan_tokens_unfiltered": prompt_tokens(plan_messages(scene=trace.scene_text, **plan_kw)),
-            "plan_tokens_filtered": prompt_tokens(plan_messages(scene=trace.planning_text, **plan_kw)),
-            "scene_tokens_unfiltered": tokens(trace.scene_text),
-            "scene_tokens_filtered": tokens(trace.planning_text),
-            "llm_calls": planner.usage.calls - calls_before,
+            "plan_tokens_unfiltered": prompt_tokens(plan_messages(scene=scene_text, **plan_kw)),
+            "plan_tokens_filtered": prompt_tokens(plan_messages(scene=planning_text, **plan_kw)),
+            "scene_tokens_unfiltered": tokens(scene_text),
+            "scene_tokens_filtered": tokens(planning_text),
+            "llm_calls": planner.llm_usage().calls - calls_before,
             "overhead_s": t1 - t0,
         })
         t2 = time.perf_counter()

@@ -33,7 +33,8 @@ sys.path.insert(0, str(REPO))
 from more_agent.eval.report import SourcedRecord  # noqa: E402
 from more_agent.eval.report_writer import write_reports  # noqa: E402
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname  # noqa: E402
-from more_agent.eval.viewer import VIEWER_FILE, run_episode_with_viewer, write_viewer  # noqa: E402
+from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE  # noqa: E402
+from more_agent.eval.viewer import run_episode_with_viewer, write_viewer  # noqa: E402
 from more_agent.llm import LLMConfig, make_client  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402
 from more_agent.records import EpisodeRecord, EpisodeSpec, Failure, LLMUsage  # noqa: E402
@@ -89,7 +90,7 @@ def comparison_runs(root: Path, record: EpisodeRecord, episode_dir: Path) -> lis
                 })
                 folder = run / EPISODE_DIRS / episode_dirname(r.task, r.scene, r.seed, r.planner)
                 folder.mkdir()
-                for name in ("map.png", VIEWER_FILE):
+                for name in (MAP_FILE, VIEWER_FILE):
                     shutil.copy(episode_dir / name, folder / name)
                 w.append(r)
                 sourced.append(SourcedRecord(r, run))

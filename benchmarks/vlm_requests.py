@@ -104,7 +104,7 @@ def run(scene: str, planner_name: str, steps: int, seed: int) -> dict[str, objec
     memory.frames, planner.memory = planner.memory.frames, memory
     rows = []
     for _ in range(steps):
-        before = dict(planner.usage.totals())
+        before = planner.llm_usage().model_dump()
         t0 = time.perf_counter()
         planner.observe()
         action = planner.decide()
@@ -112,7 +112,7 @@ def run(scene: str, planner_name: str, steps: int, seed: int) -> dict[str, objec
         upkeep = memory.seconds
         planner.execute(action)
         t2 = time.perf_counter()
-        after = planner.usage.totals()
+        after = planner.llm_usage().model_dump()
         rows.append({
             "vlm_calls": after["calls"] - before["calls"],
             "images": after["images"] - before["images"],

@@ -44,8 +44,7 @@ def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Pa
 
 def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     """A short summary of an episode for the terminal (record text shown as plain text, never markup)."""
-    from more_agent.eval.episode import EPISODE_FILE, MAP_FILE
-    from more_agent.eval.viewer import VIEWER_FILE
+    from more_agent.eval.episode_folder import EPISODE_FILE, MAP_FILE, VIEWER_FILE
 
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_column(style="bold")

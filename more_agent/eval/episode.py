@@ -4,9 +4,10 @@
 ``record.traceback`` when code raised; an LLM error is recorded without one). Every planner, the
 oracle and the LLM planners alike, runs through this one loop. Termination follows the paper
 (Sec. III-D): the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
-more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. With ``out_dir`` it writes
-``episode.json``, ``map.png`` (the plan with the robot's path) and ``timeline.jsonl`` (per-step
-goal status and path length, for the episode viewer). Timings are seconds per phase:
+more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. The step's motion (low-level
+steps and path) is read from the planner's robot, the same way for every planner. With ``out_dir``
+an :class:`~more_agent.eval.episode_folder.EpisodeFolder` writes the episode's files: the record,
+the map, each step's timeline line and the planner's step trace. Timings are seconds per phase:
 instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
 answers, part of plan) for LLM planners. Everything else in the record
 is a function of (task, scene, seed, planner, llm).
@@ -14,7 +15,6 @@ is a function of (task, scene, seed, planner, llm).
 
 from __future__ import annotations
 
-import logging
 import time
 import traceback
 from collections.abc import Iterable
@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
+from more_agent.eval.episode_folder import EpisodeFolder
 from more_agent.eval.failure import classify_failure
-from more_agent.eval.timeline import TimelineWriter
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
@@ -35,8 +35,6 @@ if TYPE_CHECKING:
     from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
 
-log = logging.getLogger(__name__)
-
 MAX_HIGH_LEVEL_STEPS = 50
 """An episode ends after this many high-level steps (paper Sec. III-D)."""
 
@@ -45,9 +43,6 @@ STEPS_AFTER_GOAL = 5
 
 LLM_ERROR_PREFIX = "LLM error"
 """Start of ``record.error`` when the LLM failed (transport, server, replay miss): the episode ended abnormally."""
-
-EPISODE_FILE = "episode.json"
-MAP_FILE = "map.png"
 
 
 def observed_task_objects(scope: dict[str, str], world_names: Iterable[str]) -> list[str]:
@@ -110,6 +105,9 @@ def run_episode(
 
     clock = _Clock()
     record = EpisodeRecord.for_spec(spec)
+    folder = None if out_dir is None else EpisodeFolder(
+        Path(out_dir), frames=save_frames or viewer, graphs=save_graph or viewer, graph_pictures=save_graph,
+    )
     world: World | None = None
     goals: GoalChecker | None = None
     scope: dict[str, str] = {}
@@ -125,11 +123,14 @@ def run_episode(
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=planner.llm, out_dir=out_dir, save_frames=save_frames or viewer,
-            save_graph=save_graph or viewer, graph_pictures=save_graph or not viewer,
+            instance=instance, goals=goals, llm=planner.llm,
+            on_frame=folder.frame_writer(world.class_names) if folder is not None else None,
+            trace_graphs=folder is not None and folder.graphs,
         ))
         clock.add("sense", t)
-        _run_steps(record, planner, goals, world, clock, TimelineWriter(Path(out_dir)) if out_dir is not None else None)
+        if folder is not None:
+            folder.start(steps_log=planner.llm is not None)
+        _run_steps(record, planner, goals, world, clock, folder)
     except LLMError as e:
         record.error = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}"
         record.retryable = isinstance(e, LLMTransportError) and not isinstance(e, (LLMAuthError, LLMBadRequest))
@@ -143,15 +144,15 @@ def run_episode(
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
     record.failure = classify_failure(record, world)
-    if out_dir is not None:
+    if folder is not None:
         t = time.perf_counter()
-        _write_map(record, world, Path(out_dir), set(scope.values()))
+        folder.write_map(record, world, set(scope.values()))
         clock.add("write", t)
     record.timings = clock.total()
     if record.llm_usage.calls:
         record.timings["llm"] = round(record.llm_usage.seconds, 6)
-    if out_dir is not None:
-        (Path(out_dir) / EPISODE_FILE).write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
+    if folder is not None:
+        folder.write_record(record)
     return record
 
 
@@ -174,34 +175,21 @@ def ended_abnormally(record: EpisodeRecord) -> bool:
     return record.traceback is not None or record.retryable or (record.error or "").startswith(LLM_ERROR_PREFIX)
 
 
-def map_is_complete(path: Path) -> bool:
-    """Whether ``path`` is a whole PNG (a crash on a full disk leaves none or a truncated one)."""
-    try:
-        with open(path, "rb") as f:
-            f.seek(-12, 2)
-            return f.read().endswith(_PNG_END)
-    except OSError:
-        return False
-
-
-_PNG_END = b"IEND\xaeB`\x82"
-
-
 def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
     rebuilt from (task, scene, seed, start) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
     instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start)
-    _write_map(record, instance.world, out_dir, set(instance.scope.values()))
+    EpisodeFolder(out_dir).write_map(record, instance.world, set(instance.scope.values()))
 
 
 def _run_steps(
     record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock,
-    timeline: TimelineWriter | None = None,
+    folder: EpisodeFolder | None = None,
 ) -> None:
     """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D);
-    each step's line goes to ``timeline`` when given."""
+    each step goes to ``folder`` when given."""
     goal_held = goals.check(world).all_met
     steps_since_goal = 0
     while record.high_level_steps < MAX_HIGH_LEVEL_STEPS:
@@ -210,7 +198,9 @@ def _run_steps(
         t = clock.add("sense", t)
         action = planner.decide()
         t = clock.add("plan", t)
-        result = planner.execute(action)
+        # The outcome with the robot's low-level steps and path since the last step (the first step's
+        # include the initial full turn).
+        result = planner.body.since_last_report(planner.execute(action))
         status = goals.check(world)
         clock.add("act", t)
         record.actions.append(ActionRecord(
@@ -220,8 +210,9 @@ def _run_steps(
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps
         _extend_path(record.trajectory, result.path)
-        if timeline is not None:
-            timeline.append(record, status, [world.display_label(a) if a in world.objects else a for a in action.arguments])
+        if folder is not None:
+            targets = [world.display_label(a) if a in world.objects else a for a in action.arguments]
+            folder.write_step(record, status, targets, planner.step_trace())
         if action.is_done:
             record.done_called = True
             if not status.all_met and action.gave_up:
@@ -244,17 +235,3 @@ def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], pl
     record.goal_conditions = list(status.conditions)
     record.observed_objects = observed_task_objects(scope, planner.observed_objects())
     record.llm_usage = planner.llm_usage()
-
-
-def _write_map(record: EpisodeRecord, world: World | None, out_dir: Path, labelled: set[str]) -> None:
-    """The map picture (when the world was built); the record itself is written last, with final timings."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    if world is None:
-        return
-    from more_agent.viz.trajectory import save_trajectory_map
-
-    try:
-        save_trajectory_map(world, record.trajectory, out_dir / MAP_FILE,
-                            title=f"{record.task} ({record.scene}, {record.planner})", labelled=labelled)
-    except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
-        log.warning("could not draw %s: %s: %s", out_dir / MAP_FILE, type(e).__name__, e)

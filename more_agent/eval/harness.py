@@ -260,7 +260,8 @@ def evaluate(
 
 def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeRecord]) -> int:
     """Redraw the ``map.png`` of recorded episodes whose picture is missing or torn; return how many."""
-    from more_agent.eval.episode import MAP_FILE, map_is_complete, redraw_map
+    from more_agent.eval.episode import redraw_map
+    from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
 
     by_key = {(r.task, r.seed, r.planner): r for r in records}
     redrawn = 0

@@ -16,10 +16,10 @@ from html import escape
 from pathlib import Path
 from urllib.parse import quote
 
+from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
 from more_agent.eval.report import SourcedRecord, fmt
 from more_agent.eval.store import EPISODE_DIRS, episode_dirname
-from more_agent.eval.viewer import VIEWER_FILE
 from more_agent.records import EpisodeRecord
 
 THUMB_PX = 160
@@ -74,7 +74,7 @@ def trajectory_svg(trajectory: Sequence[tuple[float, float]], *, size_px: int = 
 def thumbnail_html(record: EpisodeRecord, run_dir: Path, base: Path) -> str:
     """The episode's map.png linked (relative to the report folder ``base``), else its trajectory as SVG,
     else a placeholder."""
-    png = episode_file(record, run_dir, "map.png")
+    png = episode_file(record, run_dir, MAP_FILE)
     if png is not None:
         src = link(png, base)
         return f'<a href="{src}"><img alt="map" loading="lazy" width="{THUMB_PX}" src="{src}"></a>'

@@ -27,13 +27,13 @@ import numpy as np
 from PIL import Image
 
 from more_agent.errors import UserError
-from more_agent.eval.episode import EPISODE_FILE, run_episode
+from more_agent.eval.episode import run_episode
+from more_agent.eval.episode_folder import EPISODE_FILE, EpisodeFolder
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.sim.grid import Grid
 
 log = logging.getLogger(__name__)
 
-VIEWER_FILE = "viewer.html"
 FRAMES_PER_STEP = 3
 """Camera frames shown per step: evenly spaced over the step, its last frame always among them."""
 FRAME_PX = 128
@@ -51,11 +51,11 @@ def _data_uri(image: Image.Image, fmt: str) -> str:
     return f"data:image/{fmt.lower()};base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def _frame_uris(frames_dir: Path, index: int) -> dict[str, str] | None:
+def _frame_uris(folder: EpisodeFolder, index: int) -> dict[str, str] | None:
     """One frame's RGB (JPEG) and semantic (PNG) pictures, downscaled, as data URIs; None if missing."""
     out = {}
     for kind, fmt, resample in (("rgb", "JPEG", Image.Resampling.BILINEAR), ("semantic", "PNG", Image.Resampling.NEAREST)):
-        path = frames_dir / f"frame_{index:04d}_{kind}.png"
+        path = folder.frame_path(index, kind)
         if not path.is_file():
             return None
         with Image.open(path) as im:
@@ -72,7 +72,7 @@ def step_frame_indices(first: int, end: int, k: int = FRAMES_PER_STEP) -> list[i
 
 
 def _occupancy_uri(path: Path) -> tuple[str, list[float]] | None:
-    """The occupancy grid of :func:`~more_agent.viz.graph_plot.save_occupancy` coloured (north up) as a
+    """The occupancy grid of :func:`~more_agent.viz.graph_plot.occupancy_png` coloured (north up) as a
     palette PNG data URI, and its extent [x0, y0, x1, y1] in metres."""
     if not path.is_file():
         return None
@@ -87,8 +87,9 @@ def _occupancy_uri(path: Path) -> tuple[str, list[float]] | None:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), [round(v, 3) for v in extent]
 
 
-def _map(graph_json: Path) -> dict[str, Any] | None:
+def _map(folder: EpisodeFolder, step: int) -> dict[str, Any] | None:
     """The robot's map of one step for the page: regions, Voronoi graph, frontiers, objects, robot."""
+    graph_json = folder.graph_path(step)
     if not graph_json.is_file():
         return None
     g = json.loads(graph_json.read_text(encoding="utf-8"))
@@ -110,7 +111,7 @@ def _map(graph_json: Path) -> dict[str, Any] | None:
         ],
         "robot": [round(v, 2) for v in g["robot"]["position"]],
     }
-    occ = _occupancy_uri(graph_json.with_name(graph_json.stem + "_occupancy.png"))
+    occ = _occupancy_uri(folder.graph_path(step, "_occupancy.png"))
     if occ is not None:
         out["occupancy"], out["extent"] = occ
     return out
@@ -193,30 +194,23 @@ def _llm_step(line: dict[str, Any] | None) -> dict[str, Any]:
 
 def viewer_data(episode_dir: Path) -> dict[str, Any]:
     """Everything the page shows, as one JSON-ready dict."""
-    episode_dir = Path(episode_dir)
-    from more_agent.eval.timeline import TIMELINE_FILE
-    from more_agent.planners.llm_planner import STEPS_FILE
-    from more_agent.viz.frames import FRAMES_DIR
-    from more_agent.viz.graph_plot import GRAPHS_DIR
-
-    path = episode_dir / EPISODE_FILE
-    if not path.is_file():
+    folder = EpisodeFolder(Path(episode_dir))
+    if not folder.record_path.is_file():
         raise UserError(f"{episode_dir} is not an episode folder (no {EPISODE_FILE}); 'more-agent run' writes one")
-    record = EpisodeRecord.model_validate_json(path.read_text(encoding="utf-8"))
-    timeline = {t["step"]: t for t in _read_jsonl(episode_dir / TIMELINE_FILE)}
-    llm_steps = {s["step"]: s for s in _read_jsonl(episode_dir / STEPS_FILE)}
-    frames_dir, graphs_dir = episode_dir / FRAMES_DIR, episode_dir / GRAPHS_DIR
+    record = EpisodeRecord.model_validate_json(folder.record_path.read_text(encoding="utf-8"))
+    timeline = {t["step"]: t for t in _read_jsonl(folder.timeline_path)}
+    llm_steps = {s["step"]: s for s in _read_jsonl(folder.steps_path)}
     steps, first_frame = [], 0
     for action in record.actions:
         t = timeline.get(action.step, {})
         end_frame = t.get("frames", first_frame)
         picks = step_frame_indices(first_frame, end_frame)
-        frames = [{"index": i, **f} for i in picks if (f := _frame_uris(frames_dir, i))]
+        frames = [{"index": i, **f} for i in picks if (f := _frame_uris(folder, i))]
         steps.append({
             "step": action.step, "action": action.model_dump(), "frames": frames,
             "frame_range": [first_frame, end_frame],
             "goals": t.get("goals"), "progress": t.get("progress"), "path_len": t.get("path_len"),
-            "targets": t.get("targets", []), "map": _map(graphs_dir / f"step_{action.step:03d}.json"),
+            "targets": t.get("targets", []), "map": _map(folder, action.step),
             **_llm_step(llm_steps.get(action.step)),
         })
         first_frame = end_frame
@@ -224,8 +218,8 @@ def viewer_data(episode_dir: Path) -> dict[str, Any]:
         "record": record.model_dump(exclude={"actions", "trajectory", "traceback"}),
         "trajectory": [[round(x, 2), round(y, 2)] for x, y in record.trajectory],
         "steps": steps,
-        "has_frames": frames_dir.is_dir(),
-        "has_graphs": graphs_dir.is_dir(),
+        "has_frames": folder.frames_dir.is_dir(),
+        "has_graphs": folder.graphs_dir.is_dir(),
     }
 
 
@@ -245,11 +239,7 @@ def render_viewer(data: dict[str, Any]) -> str:
 
 def write_viewer(episode_dir: Path, out: Path | None = None) -> Path:
     """Write the viewer of ``episode_dir`` to ``out`` (default ``episode_dir/viewer.html``); return its path."""
-    out = Path(out) if out is not None else Path(episode_dir) / VIEWER_FILE
-    html = render_viewer(viewer_data(Path(episode_dir)))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(html, encoding="utf-8")
-    return out
+    return EpisodeFolder(Path(episode_dir)).write_viewer(render_viewer(viewer_data(Path(episode_dir))), out)
 
 
 def run_episode_with_viewer(spec: EpisodeSpec, *, out_dir: Path | None = None, **kwargs: Any) -> EpisodeRecord:

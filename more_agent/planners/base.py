@@ -2,27 +2,31 @@
 
 One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``HighLevelAction``, or
 ``done``) and ``execute(action)`` (act: run it in the world, get an ``ActionResult``). The runner
-times the three phases, counts steps and checks the goal; a planner never ends the episode itself
-except by deciding ``done``. Planners are built by name from the registry: ``make_planner('oracle')``.
-Built-in planners are listed by dotted path so that importing this module stays light; other
-code may add its own with ``register_planner``.
+times the three phases, counts steps, reads the step's motion from the planner's robot
+(``body``), checks the goal and hands the planner's ``step_trace()`` to the episode folder; a
+planner never writes files, and never ends the episode itself except by deciding ``done``.
+Planners are built by name from the registry: ``make_planner('oracle')``. Built-in planners are
+listed by dotted path so that importing this module stays light; other code may add its own with
+``register_planner``.
 """
 
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
-from dataclasses import dataclass
-from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
 
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.records import LLMUsage
 
 if TYPE_CHECKING:
+    from more_agent.planners.policies.embodiment import Embodiment
+    from more_agent.scene_graph import SceneGraph
     from more_agent.sim.actions import ActionResult
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import TaskInstance
+    from more_agent.sim.render import Frame
 
 DONE = "done"
 """Name of the action that ends an episode."""
@@ -72,14 +76,24 @@ class EpisodeContext:
     """Privileged goal access: only the oracle may read it (LLM planners get ``instance.description``)."""
     llm: str | None = None
     """LLM spec such as 'openai:gpt-4o', for planners that need one."""
-    out_dir: Path | None = None
-    """Episode output folder, for planners that save frames or graphs."""
-    save_frames: bool = False
-    """Whether to write the sensor frames of every step under ``out_dir``."""
-    save_graph: bool = False
-    """Whether to write the scene graph of every step under ``out_dir``."""
-    graph_pictures: bool = True
-    """With ``save_graph``: also draw each step's graph as a PNG (the episode viewer draws its own)."""
+    on_frame: Callable[[Frame], None] | None = None
+    """Called with every frame the robot renders (the episode folder writes them with ``--save-frames``)."""
+    trace_graphs: bool = False
+    """Whether each step's trace must carry the scene graph (``--save-graph``, ``--viewer``): a planner
+    that does not plan on one builds it only then."""
+
+
+@dataclass(frozen=True)
+class StepTrace:
+    """What a planner saw and decided in one step, for the episode folder (the runner writes it)."""
+
+    log: Mapping[str, Any] | None = None
+    """The step's line of ``steps.jsonl`` after its step number (LLM and VLM planners: the action as
+    their history holds it, scene texts, LLM exchanges, frames offered); None: the planner keeps no log."""
+    graph: SceneGraph | None = None
+    """The scene graph the step planned on (saved with ``--save-graph`` / ``--viewer``)."""
+    pictures: Mapping[str, bytes] = field(default_factory=dict)
+    """The annotated images a VLM was shown in the step, as PNG bytes by kind ('view', 'object')."""
 
 
 class Planner(Protocol):
@@ -88,6 +102,8 @@ class Planner(Protocol):
     name: str
     llm: str | None
     """The LLM it plans with as a spec (e.g. 'openai:gpt-4o'); None for the oracle."""
+    body: Embodiment
+    """The robot it drives (set by ``reset``): its odometry gives each step's low-level steps and path."""
 
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode."""
@@ -100,6 +116,9 @@ class Planner(Protocol):
 
     def execute(self, action: HighLevelAction) -> ActionResult:
         """Carry out ``action`` in the world (the act phase); failures are results, not exceptions."""
+
+    def step_trace(self) -> StepTrace:
+        """What the step just executed saw and decided."""
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has observed so far this episode."""

@@ -32,26 +32,25 @@ and object questions send one image. Invalid answers are re-asked (``max_reasks`
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from more_agent.llm import FilterAnswer, InvalidAnswer, LLMClient, UsageMeter, ask_validated, parse_filter_answer
-from more_agent.llm.completion import ChatMessage, Completion
+from more_agent.llm import FilterAnswer, InvalidAnswer, LLMClient, ask_validated, parse_filter_answer
+from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
 from more_agent.llm.prompts import filter_messages
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
-from more_agent.planners.llm_planner import INVALID, STEPS_FILE, make_clients
+from more_agent.planners.llm_planner import INVALID, make_clients
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
@@ -79,9 +78,6 @@ from more_agent.sim.render import Frame
 log = logging.getLogger(__name__)
 
 T = TypeVar("T")
-
-VLM_IMAGES_DIR = "vlm"
-"""Folder (in the episode folder, with ``--save-frames``) of the annotated images the VLM was shown."""
 
 OBSERVED_ROOM = "observed_objects"
 """The single 'room' of the scene text the filter gets under ``bumble-filter`` (BUMBLE has no rooms)."""
@@ -132,14 +128,18 @@ class PastAction:
 
 @dataclass
 class StepLog:
-    """What one step showed and got picked, for ``steps.jsonl``."""
+    """What one step showed and got picked, for its trace (``steps.jsonl``, the VLM's images)."""
 
+    subtask: str = ""
+    """The subtask of the decided action (why it is invalid, for an ``invalid`` one)."""
     offered_frames: list[int] = field(default_factory=list)
     """Buffer indices of the frames offered in the landmark / exploration question."""
     frame: int | None = None
     """Buffer index of the frame the VLM picked."""
     marks: dict[int, str] = field(default_factory=dict)
     """Mark number -> object id of the object step's image."""
+    pictures: dict[str, bytes] = field(default_factory=dict)
+    """The annotated images the VLM was shown, PNG bytes by kind ('view', 'object')."""
 
 
 class BumblePlanner:
@@ -149,9 +149,9 @@ class BumblePlanner:
         self.name = config.name
         self.llm: str | None = spec
         self.config = config
-        self.client = client
-        self.usage = UsageMeter()
-        self.llm_seconds = 0.0
+        self.calls = CallLog()
+        """Every VLM call: the episode's usage."""
+        self.client = RecordingClient(client, self.calls)
         self.body: Embodiment | None = None
         self.memory = VisualMemory(config.memory)
         self.task = ""
@@ -159,8 +159,6 @@ class BumblePlanner:
         self.subtasks: list[str] = []
         """The subtask of each action in ``history``."""
         self.feedback = ""
-        self.out_dir: Path | None = None
-        self.save_images = False
         self.graph: SceneGraph | None = None
         self.descriptions: dict[str, str] = {}
         """Object id -> how the VLM reads it ('apple A [inside fridge A]')."""
@@ -174,9 +172,9 @@ class BumblePlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer)."""
-        self.body = Embodiment.for_episode(context, config=self.config.policy, mapping=self.config.mapping)
+        writer = context.on_frame
+        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
         self.memory = VisualMemory(self.config.memory)
-        writer = self.body.on_frame
 
         def on_frame(frame: Frame) -> None:
             if writer is not None:
@@ -185,14 +183,9 @@ class BumblePlanner:
             self.memory.offer(frame)
 
         self.body.on_frame = on_frame
-        self.out_dir = context.out_dir
-        self.save_images = context.save_frames and context.out_dir is not None
-        if self.out_dir is not None:
-            self.out_dir.mkdir(parents=True, exist_ok=True)
-            (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
         self.task = context.instance.description
         self.history, self.subtasks, self.feedback = [], [], ""
-        self.usage, self.llm_seconds = UsageMeter(), 0.0
+        self.calls.new_episode()
         self.body.sense()
         self.body.look_around()
 
@@ -201,6 +194,7 @@ class BumblePlanner:
         body = self._body()
         self.memory.step = len(self.history)
         self.step_log = StepLog()
+        self.calls.new_step()
         self.graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
@@ -221,13 +215,21 @@ class BumblePlanner:
         return HighLevelAction(name=skill, arguments=arguments, note=subtask)
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run the subpolicy (explorations get the VLM's verdict as feedback); counts steps and path since the last result."""
+        """Run the subpolicy (explorations get the VLM's verdict as feedback)."""
         result = self._run(action)
         self.feedback = append_action(self.history, action, result)
         self.subtasks.append(action.note if action.name != INVALID else "")
-        if self.out_dir is not None:
-            self._write_step(self.out_dir, action)
-        return self._body().since_last_report(result)
+        self.step_log.subtask = action.note
+        return result
+
+    def step_trace(self) -> StepTrace:
+        """The step's action, subtask, the frames offered and picked (its ``steps.jsonl`` line) and the VLM's images."""
+        step = self.step_log
+        log_line = {
+            "action": self.history[-1].model_dump(), "subtask": step.subtask, "offered_frames": step.offered_frames,
+            "frame": step.frame, "marks": step.marks, "buffer_frames": len(self.memory.frames),
+        }
+        return StepTrace(log=log_line, pictures=step.pictures)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""
@@ -235,7 +237,7 @@ class BumblePlanner:
 
     def llm_usage(self) -> LLMUsage:
         """VLM traffic of this episode so far (images included), with the time spent waiting for answers."""
-        return LLMUsage(**self.usage.totals(), seconds=self.llm_seconds)
+        return self.calls.usage()
 
     # -- what the VLM sees ------------------------------------------------------------------------
     def markable(self, instance_ids: Collection[int]) -> list[str]:
@@ -269,7 +271,7 @@ class BumblePlanner:
         frame = self._current()
         ids = self.markable(set(np.unique(frame.instance).tolist()) - {0})
         view, marked = self.marked_picture(frame.rgb, frame.instance, ids, "Current view:")
-        self._save_image(view, "view")
+        self.step_log.pictures["view"] = view.png
         graph = self._graph()
         xy = graph.robot.position
         objects = [f"{self.descriptions[o]}, {math.dist(xy, graph.objects[o].position[:2]):.1f} m away" for o in marked]
@@ -298,7 +300,7 @@ class BumblePlanner:
         self.step_log.frame = frame.index
         picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
         self.step_log.marks = dict(enumerate(marked, start=1))
-        self._save_image(picture, "object")
+        self.step_log.pictures["object"] = picture.png
         m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
                                       objects=[self.descriptions[o] for o in marked]),
                       MarkAnswer, lambda a: parse_choice(a, "mark", len(marked)), "object")
@@ -362,16 +364,10 @@ class BumblePlanner:
         validate: Callable[[str | Mapping[str, Any]], T],
         purpose: str,
     ) -> T:
-        """ask_validated with this planner's re-asks; every completion is counted, also when it raises."""
-        try:
-            answer = ask_validated(
-                self.client, messages, schema, validate, max_reasks=self.config.max_reasks, purpose=purpose
-            )
-        except InvalidAnswer as e:
-            self._add(e.completions)
-            raise
-        self._add(answer.completions)
-        return answer.value
+        """ask_validated with this planner's re-asks."""
+        return ask_validated(
+            self.client, messages, schema, validate, max_reasks=self.config.max_reasks, purpose=purpose
+        ).value
 
     # -- acting ---------------------------------------------------------------------------------
     def _run(self, action: HighLevelAction) -> ActionResult:
@@ -393,28 +389,6 @@ class BumblePlanner:
         return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
 
     # -- bookkeeping ----------------------------------------------------------------------------
-    def _write_step(self, out: Path, action: HighLevelAction) -> None:
-        line = {
-            "step": self.history[-1].step, "action": self.history[-1].model_dump(), "subtask": action.note,
-            "offered_frames": self.step_log.offered_frames, "frame": self.step_log.frame, "marks": self.step_log.marks,
-            "buffer_frames": len(self.memory.frames),
-        }
-        with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
-            f.write(json.dumps(line) + "\n")
-
-    def _save_image(self, picture: Picture, kind: str) -> None:
-        """With ``--save-frames``: write an annotated image the VLM is shown as ``vlm/step_NNN_<kind>.png``."""
-        if self.save_images and self.out_dir is not None:
-            folder = self.out_dir / VLM_IMAGES_DIR
-            folder.mkdir(exist_ok=True)
-            (folder / f"step_{len(self.history):03d}_{kind}.png").write_bytes(picture.png)
-
-    def _add(self, completions: Sequence[Completion]) -> None:
-        """Count answers in this episode's usage as they arrive (an error later keeps them)."""
-        for c in completions:
-            self.usage.add(c)
-            self.llm_seconds += c.latency_s
-
     def _body(self) -> Embodiment:
         return _needed(self.body, "reset()")
 

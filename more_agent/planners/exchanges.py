@@ -1,9 +1,10 @@
-"""Every LLM request and answer of a high-level step, as plain JSON for ``steps.jsonl`` and the viewer.
+"""Every LLM request and answer of a planner: the episode's usage, metered once, and each step's
+exchanges as plain JSON for ``steps.jsonl`` and the viewer.
 
-:class:`RecordingClient` wraps an :class:`~more_agent.llm.client.LLMClient` and appends one
+:class:`RecordingClient` wraps an :class:`~more_agent.llm.client.LLMClient` and adds one
 :class:`Exchange` per call (the messages sent, the answer, tokens, latency, cache hit) to a shared
-list, so that room labels, filter, plan and every re-ask are kept without touching the callers.
-Calls that raise (timeouts, a server gone) leave no exchange: they have no answer.
+:class:`CallLog`, so that room labels, filter, plan and every re-ask are counted and kept without
+touching the callers. Calls that raise (timeouts, a server gone) leave no exchange: they have no answer.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from pydantic import BaseModel
 from more_agent.llm.client import LLMClient
 from more_agent.llm.completion import ChatMessage, Completion
 from more_agent.llm.errors import Unparseable
+from more_agent.llm.usage import UsageMeter
+from more_agent.records import LLMUsage
 
 
 @dataclass(frozen=True)
@@ -41,10 +44,39 @@ class Exchange:
         }
 
 
-class RecordingClient:
-    """An LLM client that forwards every call to ``inner`` and appends the exchange to ``log``."""
+class CallLog:
+    """The LLM calls of a planner: usage and waiting time of the episode, exchanges of the current step."""
 
-    def __init__(self, inner: LLMClient, log: list[Exchange]) -> None:
+    def __init__(self) -> None:
+        self.exchanges: list[Exchange] = []
+        self.meter = UsageMeter()
+        self.seconds = 0.0
+        """Time spent waiting for answers this episode (cache lookups included)."""
+
+    def add(self, exchange: Exchange) -> None:
+        """Count a call as soon as its answer arrives (an LLM error later keeps it)."""
+        self.exchanges.append(exchange)
+        self.meter.add(exchange.completion)
+        self.seconds += exchange.completion.latency_s
+
+    def usage(self) -> LLMUsage:
+        """The episode's traffic so far."""
+        return LLMUsage(**self.meter.totals(), seconds=self.seconds)
+
+    def new_step(self) -> None:
+        """Forget the previous step's exchanges."""
+        self.exchanges.clear()
+
+    def new_episode(self) -> None:
+        """Start counting from zero."""
+        self.new_step()
+        self.meter, self.seconds = UsageMeter(), 0.0
+
+
+class RecordingClient:
+    """An LLM client that forwards every call to ``inner`` and adds the exchange to ``log``."""
+
+    def __init__(self, inner: LLMClient, log: CallLog) -> None:
         self.inner = inner
         self.log = log
 
@@ -69,7 +101,7 @@ class RecordingClient:
         try:
             completion = self.inner.complete(messages, schema=schema, purpose=purpose, attempt=attempt)
         except Unparseable as e:
-            self.log.append(Exchange(tuple(messages), e.completion))
+            self.log.add(Exchange(tuple(messages), e.completion))
             raise
-        self.log.append(Exchange(tuple(messages), completion))
+        self.log.add(Exchange(tuple(messages), completion))
         return completion

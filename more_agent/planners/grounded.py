@@ -33,7 +33,7 @@ import math
 from collections import Counter
 from dataclasses import dataclass
 
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.language import room_names
 from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
@@ -44,7 +44,6 @@ from more_agent.records import LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.goals import Literal
-from more_agent.viz.graph_plot import save_step_graph
 
 FLOOR = "floor"
 """Object argument of a placement on the floor of a room."""
@@ -90,7 +89,7 @@ class GroundedPlanner:
     def reset(self, context: EpisodeContext) -> None:
         """Read the goal, start the robot with a full turn in place (paper S.3)."""
         self.goal: TaskGoal = task_goal(context.instance, context.goals)
-        self.body = Embodiment.for_episode(context, config=self.config)
+        self.body = Embodiment(context.instance.world, config=self.config, on_frame=context.on_frame)
         option = self.goal.options[0]
         self.skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
         """Literals no subpolicy can achieve (named when the planner calls done)."""
@@ -112,10 +111,6 @@ class GroundedPlanner:
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
         self._step: _Step | None = None
-        self._graph_dir = context.out_dir if context.save_graph else None
-        """Where each step's scene graph goes (``--save-graph`` / ``--viewer``), or None."""
-        self._graph_pictures = context.graph_pictures
-        self._steps = 0
         self.body.sense()
         self.body.look_around()
 
@@ -143,9 +138,6 @@ class GroundedPlanner:
             elif obj.label in rel or not _on_floor(self.relation.get(obj.label)):
                 self.relation[obj.label] = rel.get(obj.label)
         self.graph, self.names = graph, room_names(graph)
-        if self._graph_dir is not None:
-            save_step_graph(self._graph_dir, self._steps, graph, picture=self._graph_pictures)
-        self._steps += 1
 
     def decide(self) -> HighLevelAction:
         """``done`` when every goal literal holds as far as the robot knows, else the next action."""
@@ -155,8 +147,12 @@ class GroundedPlanner:
         return self._step.action
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run the decided step's subpolicy; the result counts the low-level steps and path since the last one."""
-        return self.body.since_last_report(self._run(action))
+        """Run the decided step's subpolicy."""
+        return self._run(action)
+
+    def step_trace(self) -> StepTrace:
+        """The scene graph the step planned on."""
+        return StepTrace(graph=self.graph)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""

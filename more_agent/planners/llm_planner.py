@@ -14,18 +14,15 @@ and the last feedback, then run that subpolicy. Planners differ only in their
 The class implements the :class:`~more_agent.planners.base.Planner` protocol. LLM transport errors
 (timeouts, a server gone, a replay miss) propagate as :class:`~more_agent.llm.errors.LLMError` for
 the episode loop to record; an answer still invalid after the bounded re-asks becomes an ``invalid``
-action whose failure is fed back to the next step, so LLM output never crashes an episode. With an
-output folder it appends each step's scene texts and action to ``steps.jsonl`` (and, with
-``save_graph``, the step's scene graph as JSON and PNG under ``graphs/``).
+action whose failure is fed back to the next step, so LLM output never crashes an episode. Each
+step's trace (:meth:`LLMPlanner.step_trace`: scene texts, action, every LLM exchange, the scene graph)
+is what the episode folder's ``steps.jsonl`` and ``graphs/`` hold.
 """
 
 from __future__ import annotations
 
-import json
 import logging
-from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -37,7 +34,6 @@ from more_agent.llm import (
     LLMConfigError,
     PlanAnswer,
     RoomLabelAnswer,
-    UsageMeter,
     ask_validated,
     configured_llm,
     filter_messages,
@@ -50,11 +46,10 @@ from more_agent.llm import (
     room_messages,
     room_spec,
 )
-from more_agent.llm.completion import Completion
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import EpisodeContext, HighLevelAction
-from more_agent.planners.exchanges import Exchange, RecordingClient
+from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
@@ -63,13 +58,8 @@ from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.skills import SKILLS
-from more_agent.viz.graph_plot import save_step_graph
 
 log = logging.getLogger(__name__)
-
-STEPS_FILE = "steps.jsonl"
-"""Per-step trace written in the episode folder: full and planning scene text, action, feedback, and
-every LLM exchange of the step (``exchanges``: messages sent, answer, tokens, latency)."""
 
 INVALID = "invalid"
 """Name of the action recorded when the LLM gave no usable answer after the re-asks."""
@@ -133,18 +123,6 @@ def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients
     return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config), spec=str(spec))
 
 
-@dataclass(frozen=True)
-class StepTrace:
-    """What the planner saw and asked in one step (for logs, benchmarks and tests)."""
-
-    scene_text: str
-    """The full scene description."""
-    planning_text: str
-    """The scene description the planner was given (the filtered one under filtering)."""
-    completions: tuple[Completion, ...]
-    """Every LLM answer of the step (room labels, filter, plan, re-asks)."""
-
-
 class LLMPlanner:
     """MORE / MoMa-LLM: the :class:`~more_agent.planners.base.Planner` protocol over an LLM (module docstring)."""
 
@@ -152,45 +130,37 @@ class LLMPlanner:
         self.name = config.name
         self.llm: str | None = clients.spec
         self.config = config
-        self.exchanges: list[Exchange] = []
-        """Every LLM call of the current step (room labels, filter, plan, re-asks), for ``steps.jsonl``."""
+        self.calls = CallLog()
+        """Every LLM call (room labels, filter, plan, re-asks): the episode's usage, the step's exchanges."""
         self.clients = LLMClients(
-            plan=RecordingClient(clients.plan, self.exchanges), room=RecordingClient(clients.room, self.exchanges),
+            plan=RecordingClient(clients.plan, self.calls), room=RecordingClient(clients.room, self.calls),
             spec=clients.spec,
         )
-        self.out_dir: Path | None = None
-        self.save_graph = False
-        self.graph_pictures = True
-        self.usage = UsageMeter()
-        self.llm_seconds = 0.0
-        """Time spent waiting for LLM answers this episode (cache lookups included)."""
         self.body: Embodiment | None = None
         self.task = ""
         self.history: list[ActionRecord] = []
         self.feedback = ""
         self.graph: SceneGraph | None = None
         self.view: SceneView | None = None
-        self.trace: StepTrace | None = None
+        """The step's full scene text."""
+        self.planning_view: SceneView | None = None
+        """The scene text the step planned on (the filtered one under filtering)."""
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
-        self.body = Embodiment.for_episode(context, config=self.config.policy, mapping=self.config.mapping)
-        self.out_dir, self.save_graph = context.out_dir, context.save_graph
-        self.graph_pictures = context.graph_pictures
-        if self.out_dir is not None:
-            self.out_dir.mkdir(parents=True, exist_ok=True)
-            (self.out_dir / STEPS_FILE).write_text("", encoding="utf-8")
+        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping,
+                               on_frame=context.on_frame)
         self.task = context.instance.description
         self.history, self.feedback = [], ""
-        self.usage, self.llm_seconds = UsageMeter(), 0.0
+        self.calls.new_episode()
         self.body.sense()
         self.body.look_around()
 
     def observe(self) -> None:
         """Build the scene graph, label new regions, put it into words."""
         body = self._body()
-        self.exchanges.clear()
+        self.calls.new_step()
         graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
         labels = self._classify_rooms(graph)
         if labels:
@@ -202,8 +172,7 @@ class LLMPlanner:
     def decide(self) -> HighLevelAction:
         """Filter (MORE) and plan: the next subpolicy call, or ``invalid`` when no valid answer came."""
         view = self._view()
-        completions: list[Completion] = []
-        planning_view = self._filter(view, completions) if self.config.filtering else view
+        planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
         messages = plan_messages(
             task=self.task, scene=planning_view.text(), robot_room=view.robot_room, held_object=view.held,
             history=self.history, feedback=self.feedback,
@@ -216,22 +185,25 @@ class LLMPlanner:
                 max_reasks=self.config.max_reasks, purpose="plan",
             )
         except InvalidAnswer as e:
-            self._add(e.completions)
-            self.trace = StepTrace(view.text(), planning_view.text(), tuple(completions) + e.completions)
             return HighLevelAction(name=INVALID, note=e.reason)
-        self._add(answer.completions)
-        self.trace = StepTrace(view.text(), planning_view.text(), tuple(completions) + answer.completions)
         planned = answer.value
         return HighLevelAction(name=planned.skill, arguments=planned.arguments, note=planned.reasoning)
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run the subpolicy; the result counts the low-level steps and path since the last result
-        (so the initial full turn is part of the first step's)."""
+        """Run the subpolicy; its outcome is the next prompt's feedback."""
         result = self._run(action)
         self.feedback = append_action(self.history, action, result)
-        if self.out_dir is not None:
-            self._write_step(self.out_dir, self.history[-1])
-        return self._body().since_last_report(result)
+        return result
+
+    def step_trace(self) -> StepTrace:
+        """The step's scene texts, action and LLM exchanges (its ``steps.jsonl`` line) and scene graph."""
+        view = self._view()
+        planning = self.planning_view or view
+        log_line = {
+            "action": self.history[-1].model_dump(), "scene": view.text(), "planning_scene": planning.text(),
+            "robot_room": view.robot_room, "exchanges": [e.to_json() for e in self.calls.exchanges],
+        }
+        return StepTrace(log=log_line, graph=self.graph)
 
     def observed_objects(self) -> set[str]:
         """World object names the robot has seen."""
@@ -239,21 +211,7 @@ class LLMPlanner:
 
     def llm_usage(self) -> LLMUsage:
         """LLM traffic of this episode so far, with the time spent waiting for answers."""
-        return LLMUsage(**self.usage.totals(), seconds=self.llm_seconds)
-
-    def _write_step(self, out: Path, action: ActionRecord) -> None:
-        """Append the step's scene texts and action to ``steps.jsonl`` (and its graph, JSON + PNG, when asked)."""
-        trace = self.trace
-        line = {
-            "step": action.step, "action": action.model_dump(),
-            "scene": trace.scene_text if trace else None, "planning_scene": trace.planning_text if trace else None,
-            "robot_room": self.view.robot_room if self.view else None,
-            "exchanges": [e.to_json() for e in self.exchanges],
-        }
-        with (out / STEPS_FILE).open("a", encoding="utf-8") as f:
-            f.write(json.dumps(line) + "\n")
-        if self.save_graph and self.graph is not None:
-            save_step_graph(out, action.step, self.graph, picture=self.graph_pictures)
+        return self.calls.usage()
 
     # -- steps ----------------------------------------------------------------------------------
     def _classify_rooms(self, graph: SceneGraph) -> dict[str, str]:
@@ -271,14 +229,12 @@ class LLMPlanner:
                     max_reasks=self.config.max_reasks, purpose="room",
                 )
             except InvalidAnswer as e:
-                self._add(e.completions)
                 log.info("room label of %s stays unknown: %s", rid, e.reason)
                 continue
-            self._add(answer.completions)
             labels[rid] = answer.value
         return labels
 
-    def _filter(self, view: SceneView, completions: list[Completion]) -> SceneView:
+    def _filter(self, view: SceneView) -> SceneView:
         """The task-relevant subgraph (paper Sec. III-B); the full view when nothing to filter or no usable answer."""
         if not any(r.objects for r in view.rooms):
             return view
@@ -289,12 +245,8 @@ class LLMPlanner:
                 max_reasks=self.config.max_reasks, purpose="filter",
             )
         except InvalidAnswer as e:
-            completions.extend(e.completions)
-            self._add(e.completions)
             log.info("filter answer unusable, planning on the full scene: %s", e.reason)
             return view
-        completions.extend(answer.completions)
-        self._add(answer.completions)
         if answer.value.unknown_rooms or answer.value.unknown_objects:
             log.warning("filter answer named unknown rooms %s / objects %s: ignored",
                         clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
@@ -318,12 +270,6 @@ class LLMPlanner:
         return run_skill(body, graph, action.name, target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
-    def _add(self, completions: Sequence[Completion]) -> None:
-        """Count answers in this episode's usage as soon as they arrive (an LLM error later keeps them)."""
-        for c in completions:
-            self.usage.add(c)
-            self.llm_seconds += c.latency_s
-
     def _body(self) -> Embodiment:
         if self.body is None:
             raise RuntimeError("reset() must be called before the first step")

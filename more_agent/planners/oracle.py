@@ -20,11 +20,11 @@ makes the oracle give up with a ``done`` whose ``gave_up`` says what failed and 
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import replace
 
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.policies import Embodiment
 from more_agent.records import LLMUsage
+from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason, approach_rounds, distance_to_footprint
 from more_agent.sim.env import ACTION_TYPES
 from more_agent.sim.goals import GoalChecker, Literal
@@ -33,7 +33,6 @@ from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import REARRANGE_PREDICATES
 from more_agent.sim.world import World, WorldObject
 from more_agent.skills import skill_named
-from more_agent.viz.graph_plot import save_step_graph
 
 ORACLE_PREDICATES = REARRANGE_PREDICATES
 """Goal predicates the oracle knows how to achieve: those of a rearrangement."""
@@ -150,12 +149,16 @@ class OraclePlanner:
         self._last_failure: dict[tuple[str, tuple[str, ...]], tuple[str, str | None]] = {}
         """Per action, the feedback and blocking door of its last failure."""
         self._observed: set[str] = set()
-        self._body = Embodiment.for_episode(context)
-        self._graph_dir = context.out_dir if context.save_graph else None
-        self._graph_pictures = context.graph_pictures
-        self._steps = 0
+        self._body = Embodiment(context.instance.world, on_frame=context.on_frame)
+        self._trace_graphs = context.trace_graphs
+        self._graph: SceneGraph | None = None
+        """The step's scene graph, built only for the trace (the oracle plans from the world)."""
         self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)
-        self._turn_steps = self._body.low_level_steps
+
+    @property
+    def body(self) -> Embodiment:
+        """The robot the oracle drives."""
+        return self._body
 
     def _adopt_next_option(self) -> bool:
         """Work on the best ground option not tried yet; False when every option has been tried."""
@@ -174,9 +177,11 @@ class OraclePlanner:
         its camera sees is what it observed (for rTP), what ``--save-frames`` writes and what the
         ``--save-graph`` scene graph is built from."""
         self._body.sense()
-        if self._graph_dir is not None:
-            save_step_graph(self._graph_dir, self._steps, self._body.build(), picture=self._graph_pictures)
-        self._steps += 1
+        self._graph = self._body.build() if self._trace_graphs else None
+
+    def step_trace(self) -> StepTrace:
+        """The scene graph of what the camera saw, when the episode asked for graphs."""
+        return StepTrace(graph=self._graph)
 
     def observed_objects(self) -> set[str]:
         """Objects the camera saw at each step, plus those the oracle acted on or revealed by opening."""
@@ -323,10 +328,9 @@ class OraclePlanner:
 
     # -- acting -------------------------------------------------------------------------------
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run a subpolicy through the magic actions; the first result also counts the initial full turn."""
+        """Run a subpolicy through the magic actions; the robot's odometry counts their motion."""
         result = self._run(action)
-        if self._turn_steps:
-            result, self._turn_steps = replace(result, low_level_steps=result.low_level_steps + self._turn_steps), 0
+        self._body.add_motion(result.path, result.low_level_steps)
         return result
 
     def _run(self, action: HighLevelAction) -> ActionResult:

@@ -1,10 +1,10 @@
 """One PNG of a scene graph: BEV occupancy, sparse Voronoi graph coloured by region, doors,
-objects, frontiers and the robot; and the per-step files of ``--save-graph`` (JSON, occupancy grid, picture)."""
+objects, frontiers and the robot; and the occupancy grid as a lossless PNG (``--save-graph``)."""
 
 from __future__ import annotations
 
+import io
 import json
-from pathlib import Path
 
 import matplotlib
 
@@ -21,9 +21,8 @@ from more_agent.scene_graph.model import OccupancyMap, SceneGraph  # noqa: E402
 _OCC_CMAP = ListedColormap(["#d9d9d9", "#ffffff", "#303030"])  # unknown, free, occupied
 
 
-def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None = None, dpi: int = 120) -> Path:
-    """Write the picture to ``path`` (PNG) and return the path. World x is to the right, y up."""
-    path = Path(path)
+def scene_graph_png(graph: SceneGraph, *, title: str | None = None, dpi: int = 120) -> bytes:
+    """The picture as PNG bytes. World x is to the right, y up."""
     fig, ax = plt.subplots(figsize=(8, 8))
     occ = graph.occupancy
     if occ is not None:
@@ -68,35 +67,18 @@ def plot_scene_graph(graph: SceneGraph, path: str | Path, *, title: str | None =
     ax.legend(loc="upper right", fontsize=7)
     ax.set_title(title or f"scene graph, step {graph.step}")
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
     plt.close(fig)
-    return path
+    return buf.getvalue()
 
 
-GRAPHS_DIR = "graphs"
-"""Folder of an episode's per-step scene graphs (``more-agent run ... --save-graph``)."""
-
-
-def save_occupancy(path: str | Path, occupancy: OccupancyMap) -> Path:
+def occupancy_png(occupancy: OccupancyMap) -> bytes:
     """The occupancy grid as a lossless greyscale PNG of its cell values (row 0 = lowest y), with its
     origin and resolution in the PNG's text chunks; a few kB, read by the episode viewer."""
-    path = Path(path)
     info = PngInfo()
     info.add_text("origin_xy", json.dumps(list(occupancy.origin_xy)))
     info.add_text("resolution_m", repr(occupancy.resolution_m))
-    Image.fromarray(np.ascontiguousarray(occupancy.grid.T.astype(np.uint8))).save(path, pnginfo=info)
-    return path
-
-
-def save_step_graph(out_dir: str | Path, step: int, graph: SceneGraph, *, picture: bool = True) -> Path:
-    """Write one step's scene graph as ``graphs/step_NNN.json``, its occupancy grid as
-    ``graphs/step_NNN_occupancy.png`` (the JSON leaves it out) and, with ``picture``, its picture
-    ``graphs/step_NNN.png`` (about 0.4 s); return the JSON's path without a picture."""
-    graphs = Path(out_dir) / GRAPHS_DIR
-    graphs.mkdir(parents=True, exist_ok=True)
-    (graphs / f"step_{step:03d}.json").write_text(graph.model_dump_json(), encoding="utf-8")
-    if graph.occupancy is not None:
-        save_occupancy(graphs / f"step_{step:03d}_occupancy.png", graph.occupancy)
-    if not picture:
-        return graphs / f"step_{step:03d}.json"
-    return plot_scene_graph(graph, graphs / f"step_{step:03d}.png", title=f"step {step}")
+    buf = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(occupancy.grid.T.astype(np.uint8))).save(buf, format="PNG", pnginfo=info)
+    return buf.getvalue()

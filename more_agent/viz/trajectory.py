@@ -1,13 +1,13 @@
 """The episode map: the floor plan in its end-of-episode state, the items, and the robot's path.
 
-``draw_trajectory`` adds a path to axes (start and end marked); ``save_trajectory_map`` writes an
+``draw_trajectory`` adds a path to axes (start and end marked); ``trajectory_map_png`` draws an
 episode's ``map.png`` on top of ``more_agent.viz.plan.draw_plan``.
 """
 
 from __future__ import annotations
 
+import io
 from collections.abc import Collection, Sequence
-from pathlib import Path
 
 import matplotlib
 
@@ -45,11 +45,11 @@ def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) 
                         xytext=(2, 2), textcoords="offset points")
 
 
-def save_trajectory_map(
-    world: World, trajectory: Sequence[tuple[float, float]], path: Path, *, title: str = "", dpi: int = 120,
+def trajectory_map_png(
+    world: World, trajectory: Sequence[tuple[float, float]], *, title: str = "", dpi: int = 120,
     labelled: Collection[str] | None = None,
-) -> None:
-    """Write the plan of ``world`` (doors and furniture as they are now), its items and the robot's path to ``path``."""
+) -> bytes:
+    """The plan of ``world`` (doors and furniture as they are now), its items and the robot's path, as PNG bytes."""
     fig, ax = plan_figure(world.scene)
     try:
         open_state = {o.name: o.is_open for o in world.objects.values() if o.openable}
@@ -57,6 +57,8 @@ def save_trajectory_map(
         draw_items(ax, world, labelled)
         draw_trajectory(ax, trajectory)
         ax.set_title(title, fontsize=9)
-        fig.savefig(path, dpi=dpi, bbox_inches="tight")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+        return buf.getvalue()
     finally:
         plt.close(fig)

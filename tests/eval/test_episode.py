@@ -33,3 +33,19 @@ def test_strict_raises_bad_input_instead_of_recording_it():
         run_episode(SPEC.model_copy(update={"planner": "oracel"}), strict=True)
     record = run_episode(SPEC.model_copy(update={"scene": "Rs_itn"}))
     assert not record.success and "closest: Rs_int" in (record.error or "") and record.traceback is None
+
+
+def test_the_folder_holds_each_steps_trace_and_frames(tmp_path):
+    from more_agent.eval.episode_folder import EpisodeFolder
+
+    record = run_episode(SPEC, out_dir=tmp_path, viewer=True)  # frames and graphs, without graph pictures
+    folder = EpisodeFolder(tmp_path)
+    steps = range(record.high_level_steps)
+    assert all(folder.graph_path(s).is_file() and folder.graph_path(s, "_occupancy.png").is_file() for s in steps)
+    assert not list(folder.graphs_dir.glob("step_???.png")) and not folder.steps_path.exists()  # the oracle keeps no log
+    timeline = [json.loads(line) for line in folder.timeline_path.read_text().splitlines()]
+    assert [t["step"] for t in timeline] == list(steps)
+    assert timeline[-1]["low_level_steps"] == record.low_level_steps and timeline[-1]["path_len"] == len(record.trajectory)
+    frames = timeline[-1]["frames"]
+    assert frames == len(list(folder.frames_dir.glob("frame_*_rgb.png"))) > record.high_level_steps
+    assert folder.frame_path(frames - 1, "semantic").is_file() and not folder.frame_path(frames, "rgb").exists()

@@ -6,8 +6,9 @@ from pathlib import Path
 
 from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
 from more_agent.eval.metrics import rtp
-from more_agent.planners.base import EpisodeContext, HighLevelAction
+from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.oracle import OraclePlanner
+from more_agent.planners.policies import Embodiment
 from more_agent.records import EpisodeRecord, EpisodeSpec, LLMUsage
 from more_agent.sim.actions import ActionResult
 
@@ -54,7 +55,7 @@ class _Idle:
     llm = None
 
     def reset(self, context: EpisodeContext) -> None:
-        pass
+        self.body = Embodiment(context.instance.world)
 
     def observe(self) -> None:
         pass
@@ -64,6 +65,9 @@ class _Idle:
 
     def execute(self, action: HighLevelAction) -> ActionResult:
         return NOTHING_HAPPENS
+
+    def step_trace(self) -> StepTrace:
+        return StepTrace()
 
     def observed_objects(self) -> set[str]:
         return set()
@@ -114,7 +118,7 @@ def test_unknown_task_is_recorded_not_raised() -> None:
 
 
 def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:
-    from more_agent.eval.episode import MAP_FILE, map_is_complete
+    from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
     from more_agent.eval.harness import evaluate
     from more_agent.eval.store import RunConfig
 

@@ -10,9 +10,8 @@ import pytest
 from typer.testing import CliRunner
 
 from more_agent.cli import app
-from more_agent.eval.timeline import TIMELINE_FILE
-from more_agent.eval.viewer import VIEWER_FILE, render_viewer, safe_json, scene_segments, step_frame_indices, viewer_data
-from more_agent.planners.llm_planner import STEPS_FILE
+from more_agent.eval.episode_folder import STEPS_FILE, TIMELINE_FILE, VIEWER_FILE
+from more_agent.eval.viewer import render_viewer, safe_json, scene_segments, step_frame_indices, viewer_data
 from tests.eval.conftest import EVIL, Episode
 
 
@@ -153,7 +152,7 @@ def test_images_of_vlm_requests_become_small_thumbnails(tmp_path: Path) -> None:
 def test_recording_client_is_transparent_and_records_unparseable_answers() -> None:
     from more_agent.llm.completion import Completion, TokenUsage
     from more_agent.llm.errors import Unparseable
-    from more_agent.planners.exchanges import Exchange, RecordingClient
+    from more_agent.planners.exchanges import CallLog, RecordingClient
 
     answer = Completion(text="no json", parsed=None, model="m", usage=TokenUsage(3, 4), cost_usd=0.0, cost_known=False,
                         cached=True, latency_s=0.01, attempts=0, purpose="plan")
@@ -165,9 +164,13 @@ def test_recording_client_is_transparent_and_records_unparseable_answers() -> No
         def complete(self, messages, *, schema=None, purpose="", attempt=0):  # noqa: ANN001, ANN202
             raise Unparseable("no JSON", completion=answer)
 
-    log: list[Exchange] = []
+    log = CallLog()
     client = RecordingClient(Inner(), log)
     assert client.model == "m" and client.cache == "the cache"
     with pytest.raises(Unparseable):
         client.complete([{"role": "user", "content": "hi"}], purpose="plan")
-    assert [x.to_json()["answer"] for x in log] == ["no json"] and log[0].to_json()["cached"] is True
+    assert [x.to_json()["answer"] for x in log.exchanges] == ["no json"] and log.exchanges[0].to_json()["cached"] is True
+    usage = log.usage()  # an unusable answer is still paid for: counted once, as it arrived
+    assert (usage.calls, usage.prompt_tokens, usage.completion_tokens, usage.cache_hits) == (1, 3, 4, 1)
+    log.new_step()
+    assert log.exchanges == [] and log.usage().calls == 1

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -26,9 +26,6 @@ from more_agent.sim.motion import full_turn_angles
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
-
-if TYPE_CHECKING:
-    from more_agent.planners.base import EpisodeContext
 
 
 class PolicyConfig(BaseModel):
@@ -66,6 +63,7 @@ class Embodiment:
         config: PolicyConfig | None = None,
         mapping: MappingConfig | None = None,
         renderer: Renderer | None = None,
+        on_frame: Callable[[Frame], None] | None = None,
     ) -> None:
         self.world = world
         self.env = MoreAgentEnv(sensors=False, max_steps=None)
@@ -81,22 +79,9 @@ class Embodiment:
         self._reported_steps, self._reported_path = 0, 1
         self.bumps: list[XY] = []
         """Where blocked moves met something (just ahead of the base): obstacles on the robot's map."""
-        self.on_frame: Callable[[Frame], None] | None = None
+        self.on_frame = on_frame
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
-
-    @classmethod
-    def for_episode(
-        cls, context: EpisodeContext, *, config: PolicyConfig | None = None, mapping: MappingConfig | None = None
-    ) -> Embodiment:
-        """The robot in the episode's world; with ``context.save_frames`` every rendered frame is written
-        under ``out_dir/frames``."""
-        body = cls(context.instance.world, config=config, mapping=mapping)
-        if context.save_frames and context.out_dir is not None:
-            from more_agent.viz.frames import FRAMES_DIR, FrameWriter  # lazy: matplotlib only when writing frames
-
-            body.on_frame = FrameWriter(context.out_dir / FRAMES_DIR, body.world.class_names)
-        return body
 
     @property
     def xy(self) -> XY:
@@ -158,7 +143,7 @@ class Embodiment:
     def act(self, kind: str, target: str = "") -> ActionResult:
         """One magic action of the env (a world action of the skill table: ``navigate_to``, ``grasp``,
         ..., ``done``) on ``target``, a world name or label. Its steps and path are not accounted here
-        (the oracle reports them itself; the subpolicies pass them to :meth:`record_jump`)."""
+        (the oracle passes them to :meth:`add_motion`, the subpolicies to :meth:`record_jump`)."""
         info = self._step(kind, target=target)
         reason = FailureReason(info["reason"]) if info["reason"] else None
         return ActionResult(ok=info["action_ok"], reason=reason, feedback=info["feedback"],
@@ -223,7 +208,11 @@ class Embodiment:
 
     def record_jump(self, path: Sequence[XY], steps: int) -> None:
         """Account for a motion a magic action made (its path and low-level steps), then sense."""
-        self.low_level_steps += steps
-        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
+        self.add_motion(path, steps)
         if path:
             self.sense()
+
+    def add_motion(self, path: Sequence[XY], steps: int) -> None:
+        """Count a motion made by a magic action (its path, start included, and low-level steps) without sensing."""
+        self.low_level_steps += steps
+        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
