@@ -18,7 +18,7 @@ from pydantic import BaseModel
 
 from more_agent.llm.cache import CachedAnswer, ResponseCache, request_key
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
-from more_agent.llm.concurrency import llm_limiter
+from more_agent.llm.concurrency import LLMConcurrencyLimiter, llm_limiter
 from more_agent.llm.config import CacheMode, ModelPrice
 from more_agent.llm.errors import OversizeAnswer, ReplayMiss, Unparseable
 from more_agent.llm.images import cache_view, image_stats
@@ -105,6 +105,7 @@ class ChatClient:
         max_tokens: int = 1024,
         seed: int | None = None,
         prices: Mapping[str, ModelPrice] | None = None,
+        limiter: LLMConcurrencyLimiter | None = None,
     ) -> None:
         if cache is None and cache_mode in (CacheMode.ON, CacheMode.REFRESH, CacheMode.REPLAY):
             raise ValueError(f"cache mode {cache_mode.value!r} needs a cache")
@@ -116,6 +117,9 @@ class ChatClient:
         self.seed = seed
         self.prices = dict(prices or {})
         self.usage = UsageMeter()
+        self.limiter = limiter or llm_limiter()
+        """Held around each request: one cap on concurrent calls across evaluation workers (default:
+        the limiter the harness installed in this worker process)."""
 
     @property
     def model(self) -> str:
@@ -157,7 +161,7 @@ class ChatClient:
         if hit is not None:
             answer, attempts = hit, 0
         else:
-            with llm_limiter():  # one cap on concurrent calls across evaluation workers
+            with self.limiter:
                 gen = self.backend.generate(request)
             # Clipped (an oversize answer is stored truncated) and redacted (a server echoing a key).
             answer = CachedAnswer(

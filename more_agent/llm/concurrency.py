@@ -4,7 +4,8 @@
 llm_limiter(): ...``). Implementations: ``NullLimiter`` (no limit, in-process runs),
 ``ProcessLimiter`` (a multiprocessing semaphore shared with the process pool's workers) and
 ``more_agent.eval.ray_backend.RayLimiter`` (a Ray actor semaphore). The harness installs the
-limiter of the current worker with ``set_llm_limiter``; clients read it with ``llm_limiter()``.
+limiter of the current worker with ``set_llm_limiter``; a client is given one at construction
+(``ChatClient(limiter=...)``) and otherwise takes the one installed in its process (``llm_limiter()``).
 """
 
 from __future__ import annotations

@@ -190,3 +190,40 @@ def test_structured_output_always_and_never(fake_openai: FakeOpenAIServer, llm_c
     never = make_client("openai:gpt-4o", llm_config.model_copy(update={"structured_output": StructuredOutput.NEVER}))
     assert never.complete(MESSAGES, schema=RoomLabelAnswer).parsed == {"room": "den"}
     assert "response_format" not in fake_openai.requests[-1].body
+
+
+class _CountingLimiter:
+    """A limiter that counts the requests it let through."""
+
+    def __init__(self) -> None:
+        self.entered = 0
+
+    def acquire(self) -> None:
+        self.entered += 1
+
+    def release(self) -> None:
+        pass
+
+    def __enter__(self) -> _CountingLimiter:
+        self.acquire()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+
+def test_the_client_holds_the_limiter_it_was_built_with_around_requests_only(
+    fake_openai: FakeOpenAIServer, llm_config: LLMConfig
+) -> None:
+    from more_agent.llm.concurrency import set_llm_limiter
+
+    installed = _CountingLimiter()
+    set_llm_limiter(installed)  # what the harness does in each worker
+    try:
+        client = make_client("openai:gpt-4o", llm_config)
+    finally:
+        set_llm_limiter(None)
+    fake_openai.push('{"room": "kitchen"}')
+    client.complete(MESSAGES)
+    client.complete(MESSAGES)  # answered from the cache: no slot taken
+    assert client.limiter is installed and installed.entered == 1
