@@ -2,7 +2,8 @@
 
 For each scene, a paper task that suits it is instantiated and the MORE planner runs ``--steps``
 high-level steps driven by an in-process scripted LLM (no network): rooms are labelled by a keyword
-rule, the filter keeps the objects of the task's categories (an ideal filter's answer), and the
+rule, the filter keeps the objects of the task's categories and the rooms that hold one or have
+unexplored areas (an ideal answer to the filter prompt, which asks to keep exactly those), and the
 plan explores the rooms with unexplored areas in turn. On every recorded state the planning prompt
 is rendered twice, once with the full scene text (no filtering, as MoMa-LLM) and once with the
 filtered text (MORE), so both sizes come from the same states. Unless ``--keep-doors`` is given,
@@ -18,7 +19,10 @@ with filtering.
 labels, language, filtering, parsing) on one core; ``act_s`` is the subpolicy's time (motion,
 rendering and fusing frames).
 
+``--task`` runs that task in every scene instead (for scenes no paper task suits, e.g. most offices).
+
     python benchmarks/prompt_tokens.py [--scenes house_single_floor Beechwood_0_garden ...] [--steps 30] [--keep-doors]
+        [--task T]
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+from more_agent.errors import UserError  # noqa: E402
 from more_agent.llm import plan_messages  # noqa: E402
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage  # noqa: E402
 from more_agent.llm.errors import LLMConfigError  # noqa: E402
@@ -83,9 +88,18 @@ def prompt_tokens(messages: Sequence[ChatMessage]) -> int:
     return sum(tokens(m["content"]) + 4 for m in messages)
 
 
+def _scene_lines(user: str) -> str:
+    return user.split("Scene:\n", 1)[1].split("\n\n", 1)[0]
+
+
+def _unexplored_rooms(user: str) -> list[str]:
+    """Rooms marked as having unexplored areas in the scene lines of a prompt."""
+    return re.findall(r"^(\S+) \(unexplored areas\)", _scene_lines(user), flags=re.M)
+
+
 def _scene_entries(user: str) -> dict[str, list[tuple[str, str]]]:
     """Room -> (object name, attributes) from the scene lines of a prompt."""
-    scene = user.split("Scene:\n", 1)[1].split("\n\n", 1)[0]
+    scene = _scene_lines(user)
     rooms: dict[str, list[tuple[str, str]]] = {}
     for line in scene.splitlines():
         head, _, body = line.partition(": ")
@@ -113,13 +127,13 @@ class ScriptedLLM:
             room = next((r for r, keys in _ROOM_WORDS.items() if any(k in words for k in keys)), "living_room")
             answer: dict[str, Any] = {"room": room}
         elif purpose == "filter":
-            rooms = _scene_entries(user)
-            answer = {"rooms": [
-                {"room": r, "objects": [n for n, _ in objs if n.rsplit(" ", 1)[0] in self.categories]}
-                for r, objs in rooms.items()
-            ]}
+            unexplored = set(_unexplored_rooms(user))
+            kept = {r: [n for n, _ in objs if n.rsplit(" ", 1)[0] in self.categories]
+                    for r, objs in _scene_entries(user).items()}
+            answer = {"rooms": [{"room": r, "objects": objs} for r, objs in kept.items()
+                                if r in unexplored or set(objs) - {"floor"}]}
         else:
-            unexplored = re.findall(r"^(\S+) \(unexplored areas\)", user.split("Scene:\n", 1)[1], flags=re.M)
+            unexplored = _unexplored_rooms(user)
             self.turn += 1
             answer = ({"reasoning": "", "skill": "explore", "arguments": [unexplored[self.turn % len(unexplored)]]}
                       if unexplored else {"reasoning": "", "skill": "done", "arguments": []})
@@ -134,11 +148,12 @@ def pick_task(scene: str) -> str | None:
     return next((t for t in task_set("more-paper") if scene in suitable_scenes(t)), None)
 
 
-def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True) -> dict[str, object]:
-    """Record ``steps`` planning steps in one scene; sizes and times per step, summarised."""
-    task = pick_task(scene)
+def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True, task: str | None = None) -> dict[str, object]:
+    """Record ``steps`` planning steps in one scene (with ``task``, else the first paper task that
+    suits it); sizes and times per step, summarised."""
+    task = task or pick_task(scene)
     if task is None:
-        return {"scene": scene, "error": "no paper task suits this scene"}
+        return {"scene": scene, "error": "no paper task suits this scene (pass --task)"}
     instance = instantiate(task, scene, seed)
     if open_doors:
         for door in instance.world.scene.doors:
@@ -190,9 +205,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--steps", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--keep-doors", action="store_true", help="leave doors as generated (some closed)")
+    parser.add_argument("--task", help="run this task in every scene (default: the first paper task that suits it)")
     args = parser.parse_args(argv)
     for scene in args.scenes:
-        print(json.dumps(run_scene(scene, args.steps, args.seed, open_doors=not args.keep_doors)), flush=True)
+        try:
+            line = run_scene(scene, args.steps, args.seed, open_doors=not args.keep_doors, task=args.task)
+        except UserError as e:  # an unknown task or scene, a task the scene does not suit
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+        print(json.dumps(line), flush=True)
     return 0
 
 

@@ -8,9 +8,10 @@ the rest back into a world as items, each with its category's real (median) size
 - what: every listed category that the generator drops as small (``furniture_role == 'skip'``),
   has a sized model and is not a structural fixture, up to ``MAX_PER_CATEGORY`` per room and
   ``MAX_PER_ROOM`` per room in all (counts scaled down in proportion when a room lists more);
-- where: on the tops of the room's furniture (shelves, counters, tables, desks, cabinets, ...)
-  and inside its openable furniture (cabinets, fridges, drawers: closed ones hide what they hold,
-  as for task items), a support drawn with probability proportional to its free area;
+- where: on the tops of the room's surfaces (tables, desks, counters, shelves, cabinets, beds,
+  sofas, ...: ``SURFACE_SYNSETS``) and inside its storage furniture (cabinets, lockers, fridges,
+  boxes: ``CONTAINER_SYNSETS``; closed ones hide what they hold, as for task items), a support
+  drawn with probability proportional to its free area;
   ``FLOOR_SHARE`` of them, and those no support has room for, on a free floor spot. An item for
   which no room is left anywhere is not added (counted in ``Clutter.dropped``).
 
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 import zlib
 from dataclasses import dataclass, field
+from functools import cache
 
 import numpy as np
 
@@ -48,15 +50,20 @@ MAX_SUPPORT_TOP_M = 2.0
 MIN_SUPPORT_TOP_M = 0.25
 """Furniture lower than this (mats, low platforms) is not used as a surface."""
 
-NO_SUPPORT_CATEGORIES: frozenset[str] = frozenset(
-    catalog.VEHICLE_CATEGORIES | set(catalog.ROLE_CAPS) | {
-        "straight_chair", "swivel_chair", "armchair", "eames_chair", "rocking_chair", "garden_chair",
-        "music_stool", "toilet", "bathtub", "shower", "swimming_pool", "wading_pool", "hot_tub",
-        "treadmill", "elliptical_machine", "exercise_bike", "fence", "pergola", "arbor", "swing",
-        "swing_set", "playground", "hammock", "garden_umbrella",
-    }
-)
-"""Furniture nothing is put on or in: vehicles, plants, seats, fixtures with water, machines."""
+SURFACE_SYNSETS: frozenset[str] = frozenset({
+    "table.n.02", "carrel.n.02", "work_surface.n.01", "shelf.n.01", "bookcase.n.01", "grocery_shelf.n.01",
+    "snack_rack.n.01", "cabinet.n.01", "bed.n.01", "hospital_bed.n.02", "sofa.n.01", "bench.n.01",
+    "handcart.n.01", "free_weight_rack.n.01", "sink.n.01", "stove.n.01", "grill.n.02",
+})
+"""Furniture whose top things are put on, by bddl synset and its descendants: tables and desks
+(counters and office cubicles included), worktops, shelves, bookcases, cabinets, beds, sofas and
+benches, carts, weight racks, sinks (basin and rim) and cooktops (stoves, grills). Not monitors,
+lamps, plants, machines, bins, fixtures or the chairs one sits on: nobody leaves a keyboard on a
+monitor or a book on a range hood."""
+
+CONTAINER_SYNSETS: frozenset[str] = frozenset({"cabinet.n.01", "cabinet.n.03", "refrigerator.n.01", "box.n.01"})
+"""Openable furniture things are stored inside: cabinets, lockers, fridges, boxes (cartons); not
+ovens, dishwashers, washers or laptops."""
 
 FIXTURE_CATEGORIES: frozenset[str] = frozenset({"handle", "l_shaped_handle", "door_handle", "knob", "hinge"})
 """Small listed parts of other objects, not objects of their own."""
@@ -112,6 +119,23 @@ def _scale_to(total: int, counts: dict[str, int]) -> dict[str, int]:
     return out
 
 
+@cache
+def is_surface(category: str) -> bool:
+    """Whether distractors are put on top of this furniture category (``SURFACE_SYNSETS``)."""
+    return _descends_from(category, SURFACE_SYNSETS)
+
+
+@cache
+def is_storage(category: str) -> bool:
+    """Whether distractors are stored inside this (openable) furniture category (``CONTAINER_SYNSETS``)."""
+    return _descends_from(category, CONTAINER_SYNSETS)
+
+
+def _descends_from(category: str, synsets: frozenset[str]) -> bool:
+    tax = catalog.taxonomy()
+    return any(synsets & {s, *tax.get_ancestors(s)} for s in catalog.category_synsets(category))
+
+
 def _is_loose(category: str) -> bool:
     return (category not in catalog.SKIPPED_CATEGORIES and category not in FIXTURE_CATEGORIES
             and catalog.furniture_role(category) == "skip")
@@ -156,11 +180,11 @@ class _RoomPlacer:
         self.world, self.room, self.rng = world, room, rng
         self.supports: list[tuple[WorldObject, Relation]] = []
         for obj in world.objects.values():
-            if obj.kind != "furniture" or obj.room != room or obj.category in NO_SUPPORT_CATEGORIES:
+            if obj.kind != "furniture" or obj.room != room:
                 continue
-            if MIN_SUPPORT_TOP_M <= obj.top <= MAX_SUPPORT_TOP_M:
+            if MIN_SUPPORT_TOP_M <= obj.top <= MAX_SUPPORT_TOP_M and is_surface(obj.category):
                 self.supports.append((obj, "ontop"))
-            if obj.openable:
+            if obj.openable and is_storage(obj.category):
                 self.supports.append((obj, "inside"))
         self.area = np.array([_surface_area(world, s, rel) for s, rel in self.supports])
         self.full: set[tuple[int, str]] = set()

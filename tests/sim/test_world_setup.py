@@ -10,13 +10,23 @@ import pytest
 
 from more_agent.errors import UserError
 from more_agent.sim.actions import approach_rounds
-from more_agent.sim.clutter import MAX_PER_CATEGORY, MAX_PER_ROOM, add_distractors, room_item_counts
+from more_agent.sim.clutter import (
+    MAX_PER_CATEGORY,
+    MAX_PER_ROOM,
+    add_distractors,
+    clutter_rng,
+    is_storage,
+    is_surface,
+    room_item_counts,
+)
 from more_agent.sim.instantiate import instantiate, instantiate_in_scene
 from more_agent.sim.navgrid import nav_grid, shortest_path
 from more_agent.sim.render import Renderer, instance_table
 from more_agent.sim.scene import load_scene, save_scene
+from more_agent.sim.scenes import get_scene
 from more_agent.sim.start import random_start
 from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, episode_scenes, suitable_scenes
+from more_agent.sim.world import World
 
 KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -113,6 +123,24 @@ def test_distractors_rest_on_supports_inside_containers_and_on_the_floor() -> No
                 if a.relation == b.relation:
                     gap = np.abs(a.center[:2] - b.center[:2]) - (a.size[:2] + b.size[:2]) / 2
                     assert np.any(gap >= -1e-9), (a.name, b.name)
+
+
+def test_surfaces_and_storage_follow_the_taxonomy() -> None:
+    assert all(map(is_surface, ("desk", "cubicle", "countertop", "shelf", "bottom_cabinet", "sofa", "shopping_cart")))
+    assert not any(map(is_surface, ("monitor", "table_lamp", "range_hood", "pot_plant", "bicycle", "swivel_chair")))
+    assert all(is_storage(c) for c in ("bottom_cabinet", "locker", "fridge", "carton"))
+    assert not any(is_storage(c) for c in ("oven", "laptop", "dishwasher", "blender"))
+
+
+def test_office_distractors_rest_on_desks_and_tables_not_on_monitors() -> None:
+    world = World.from_scene(get_scene("office_large", 0))
+    clutter = add_distractors(world, clutter_rng("office_large", 0))
+    supports = Counter(world.get(world.get(n).parent).category for n in clutter.items)
+    assert supports["desk"] + supports["conference_table"] > len(clutter.items) / 3
+    furniture = {o.category for o in world.objects.values() if o.kind == "furniture"}
+    assert {"monitor", "photocopier", "bottom_cabinet"} <= furniture
+    for category in supports:
+        assert category.startswith("floor") or is_surface(category) or is_storage(category), category
 
 
 def test_grocery_store_is_cluttered_and_deterministic() -> None:
