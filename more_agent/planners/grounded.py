@@ -18,7 +18,7 @@ Every step (MPC style) it rebuilds the scene graph and:
    not need;
 4. when a needed object is unseen: opens the closed containers of the robot's room when it is where
    the search would look anyway (three in a row at most while there is a room to explore); explores
-   first the rooms holding objects of the task (the rest is likely near), then the room type most
+   first the rooms where objects the goal moves were found (the rest is likely near), then the room type most
    likely to hold what is missing (BEHAVIOR-1K room inventories), the room explored least often, the
    nearest; a room explored its share of times (three, ten where task objects are: open ground keeps
    showing unexplored areas at sensor range) yields to the others, to the closed containers and to
@@ -103,6 +103,10 @@ class GroundedPlanner:
         self.bound: dict[str, str] = {}
         self.seen: dict[str, ObjectNode] = {}
         """Label -> the object as last observed (objects of rooms now out of reach included)."""
+        self.found_in: dict[str, str] = {}
+        """Label -> the region it was first seen in (before the robot moved it)."""
+        self.movers = {lit.args[0] for lit in self.literals if lit.predicate != "open" and lit.args[0] != self.goal.robot}
+        """Scopes the goal moves: where they were found is where the task is."""
         self.relation: dict[str, Relation | None] = {}
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
@@ -141,6 +145,8 @@ class GroundedPlanner:
         rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
         for obj in graph.objects.values():
             self.seen[obj.label] = obj
+            if obj.region_id is not None:
+                self.found_in.setdefault(obj.label, obj.region_id)
             if obj.open:
                 self.looked_into.add(obj.label)
             if obj.held:
@@ -365,13 +371,14 @@ class GroundedPlanner:
         return min(open_regions, key=lambda rid: self._region_key(rid, cats)) if open_regions else None
 
     def _region_key(self, rid: str | None, cats: list[str]) -> tuple[bool, bool, float, int, float, str]:
-        """Search order of regions: those explored less than their share first; then regions holding
-        objects of the task (what is missing is likely near them), then the room type most likely to
-        hold ``cats``, the region explored least, the nearest."""
+        """Search order of regions: those explored less than their share first; then regions where objects
+        the goal moves were found (what is missing is likely near them; not where they are to go: the
+        newspaper to bring in is not by the coffee table), then the room type most likely to hold
+        ``cats``, the region explored least, the nearest."""
         if rid is None or rid not in self._graph().regions:
             return (True, True, 0.0, 0, math.inf, "")
         region = self._graph().regions[rid]
-        task_here = bool(set(region.object_ids) & set(self.bound.values()))
+        task_here = any(self.found_in.get(self.bound.get(s, "")) == rid for s in self.movers)
         kind = self.room_types.get(rid)
         like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
         share = EXPLORES_WHERE_THE_TASK_IS if task_here else EXPLORES_BEFORE_MOVING_ON

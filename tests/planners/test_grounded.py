@@ -79,7 +79,7 @@ def test_room_types_from_furniture() -> None:
 
 
 def _two_room_graph(robot_xy: tuple[float, float]) -> SceneGraph:
-    """A region holding the checkout (typed a bathroom, as a store may be) and a kitchen, both with unexplored areas."""
+    """A region holding a checkout (typed a bathroom, as a store may be) and a kitchen, both with unexplored areas."""
     def obj(label: str, category: str, region: str, xy: tuple[float, float]) -> ObjectNode:
         box = Box3D(min=(xy[0] - 0.2, xy[1] - 0.2, 0.0), max=(xy[0] + 0.2, xy[1] + 0.2, 0.9))
         return ObjectNode(id=label, category=category, instance_id=len(label), label=label, region_id=region,
@@ -99,22 +99,24 @@ def _two_room_graph(robot_xy: tuple[float, float]) -> SceneGraph:
                       regions=regions, objects={o.label: o for o in objects}, relations=[], nav=nav)
 
 
-def test_search_stays_where_the_task_objects_are_before_the_likelier_room_type(kitchen: TaskInstance) -> None:
-    """An apple is missing; the kitchen is the likelier room type for it, but the checkout the goal binds
-    stands in the store: the store is explored (up to its larger share) and its containers opened first."""
+def test_search_stays_where_the_task_objects_were_found_before_the_likelier_room_type(kitchen: TaskInstance) -> None:
+    """An apple is missing; the kitchen is the likelier room type for it, but the ground beef the
+    goal also moves was found in the other region: that one is explored (up to its larger share)."""
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     planner.graph = _two_room_graph((8.0, 2.0))
     planner.room_types = {"region_0": "bathroom", "region_1": "kitchen"}
     planner.explored.clear()
-    planner.bound = {}
-    assert planner._room_to_explore(["apple"]) == "region_1"  # nothing of the task seen: the room type decides
-    planner.bound = {"checkout.n.03_1": "checkout_counter A"}
-    assert planner._room_to_explore(["apple"]) == "region_0"
+    planner.found_in = {"checkout_counter A": "region_0", "fridge A": "region_1"}
+    cats = ["apple"]
+    planner.bound = {"cabinet.n.01_1": "checkout_counter A"}  # where things go is not where they are
+    assert planner._room_to_explore(cats) == "region_1"
+    planner.bound = {"pack__of__ground_beef.n.01_1": "checkout_counter A"}
+    assert planner._room_to_explore(cats) == "region_0"
     planner.explored["region_0"] = EXPLORES_WHERE_THE_TASK_IS - 1
-    assert planner._room_to_explore(["apple"]) == "region_0"
+    assert planner._room_to_explore(cats) == "region_0"
     planner.explored["region_0"] = EXPLORES_WHERE_THE_TASK_IS  # its share is spent: the others come first
-    assert planner._room_to_explore(["apple"]) == "region_1"
+    assert planner._room_to_explore(cats) == "region_1"
 
 
 def test_containers_here_are_opened_only_where_the_search_would_look_anyway(kitchen: TaskInstance) -> None:
@@ -132,7 +134,8 @@ def test_containers_here_are_opened_only_where_the_search_would_look_anyway(kitc
     wanted = Literal("inside", ("canned_food.n.01_1", "cabinet.n.01_1"))
     step = planner._search(wanted, None)
     assert (step.action.name, step.target) == ("go_to_and_open", "fridge A")
-    planner.bound = {"sack.n.01_1": "checkout_counter A"}  # a task object in the other region
+    planner.found_in = {"checkout_counter A": "region_0"}
+    planner.bound = {"pack__of__ground_beef.n.01_1": "checkout_counter A"}  # found in the other region
     step = planner._search(wanted, None)
     assert (step.action.name, step.region) == ("explore", "region_0")
     planner.explored.update({"region_0": EXPLORES_WHERE_THE_TASK_IS, "region_1": 3})  # both had their share
