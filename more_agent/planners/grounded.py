@@ -16,13 +16,11 @@ Every step (MPC style) it rebuilds the scene graph and:
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place, put down what the hand holds but does
    not need;
-4. when a needed object is unseen: opens the closed containers of the robot's room when it is where
-   the search would look anyway (three in a row at most while there is a room to explore); explores
-   first the rooms where objects the goal moves were found (the rest is likely near), then the room type most
-   likely to hold what is missing (BEHAVIOR-1K room inventories), the room explored least often, the
-   nearest; a room explored its share of times (three, ten where task objects are: open ground keeps
-   showing unexplored areas at sensor range) yields to the others, to the closed containers and to
-   the closed doors; it gives up with ``done`` when nothing is left to try.
+4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
+   at most while there is a room to explore), explores the
+   room most likely to hold what is missing (BEHAVIOR-1K room inventories; rooms explored three
+   times yield to the others; then the room explored least often, then the nearest), then opens other containers, then closed doors; it gives up with
+   ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
@@ -59,9 +57,6 @@ OPENS_BEFORE_EXPLORING = 3
 
 EXPLORES_BEFORE_MOVING_ON = 3
 """A room explored this often yields to rooms explored less, however likely it is to hold what is missing."""
-
-EXPLORES_WHERE_THE_TASK_IS = 10
-"""The same for a room where objects of the task were found (a store, a garden): the rest is likely near."""
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
@@ -103,10 +98,6 @@ class GroundedPlanner:
         self.bound: dict[str, str] = {}
         self.seen: dict[str, ObjectNode] = {}
         """Label -> the object as last observed (objects of rooms now out of reach included)."""
-        self.found_in: dict[str, str] = {}
-        """Label -> the region it was first seen in (before the robot moved it)."""
-        self.movers = {lit.args[0] for lit in self.literals if lit.predicate != "open" and lit.args[0] != self.goal.robot}
-        """Scopes the goal moves: where they were found is where the task is."""
         self.relation: dict[str, Relation | None] = {}
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
@@ -145,8 +136,6 @@ class GroundedPlanner:
         rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
         for obj in graph.objects.values():
             self.seen[obj.label] = obj
-            if obj.region_id is not None:
-                self.found_in.setdefault(obj.label, obj.region_id)
             if obj.open:
                 self.looked_into.add(obj.label)
             if obj.held:
@@ -325,9 +314,8 @@ class GroundedPlanner:
         return predicate == "inside" and obj.open is False
 
     def _search(self, lit: Literal, held: str | None) -> _Step:
-        """Look for an unseen object of ``lit``: containers here when this is where the search would look
-        anyway, the next room to explore (``_region_key``) while it has had fewer explores than its
-        share, other containers, closed doors, rooms past their share; give up when none is left."""
+        """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
+        containers, closed doors; give up when none is left."""
         graph = self._graph()
         missing = [s for s in lit.args if s != self.goal.robot and not self.goal.is_floor(s) and self._label(s) is None]
         note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
@@ -337,25 +325,17 @@ class GroundedPlanner:
              if o.open is False and o.category != "door" and o.label not in self.looked_into and o.label not in self.dropped),
             key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
         )
-        cats = [c for s in missing for c in self.goal.categories.get(s, ())]
-        region = self._room_to_explore(cats)
-        promising = region is None or self._region_key(here, cats)[1:3] <= self._region_key(region, cats)[1:3]
-        if (closed and closed[0].region_id == here and promising
-                and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)):
+        region = self._room_to_explore(missing)
+        if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
             return self._open_to_look(closed[0].label, held, note)
-        explore = _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region) if region else None
-        if explore is not None and not self._region_key(region, cats)[0]:
-            return explore
-        # Every region with unexplored areas had its share (open ground keeps showing new ones at
-        # sensor range): what is closed comes first, containers, then doors to rooms not seen yet.
+        if region is not None:
+            return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region)
         if closed:
             return self._open_to_look(closed[0].label, held, note)
         doors = sorted((o for o in graph.objects.values() if o.category == "door" and o.open is False
                         and o.label not in self.dropped), key=lambda o: math.dist(o.position[:2], self.body.xy))
         if doors:
             return self._open_to_look(doors[0].label, held, note)
-        if explore is not None:
-            return explore
         why = f"{note}: nothing left to explore or open"
         return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
@@ -364,26 +344,19 @@ class GroundedPlanner:
             return self._put_down(held)
         return self._object_step("go_to_and_open", label, note)
 
-    def _room_to_explore(self, cats: list[str]) -> str | None:
-        """The region with unexplored areas to explore next for objects of ``cats`` (``_region_key``)."""
+    def _room_to_explore(self, missing: list[str]) -> str | None:
+        """The region with unexplored areas most likely to hold the missing furniture, nearest first."""
         graph = self._graph()
-        open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
-        return min(open_regions, key=lambda rid: self._region_key(rid, cats)) if open_regions else None
+        cats = [c for s in missing for c in self.goal.categories.get(s, ())]
 
-    def _region_key(self, rid: str | None, cats: list[str]) -> tuple[bool, bool, float, int, float, str]:
-        """Search order of regions: those explored less than their share first; then regions where objects
-        the goal moves were found (what is missing is likely near them; not where they are to go: the
-        newspaper to bring in is not by the coffee table), then the room type most likely to hold
-        ``cats``, the region explored least, the nearest."""
-        if rid is None or rid not in self._graph().regions:
-            return (True, True, 0.0, 0, math.inf, "")
-        region = self._graph().regions[rid]
-        task_here = any(self.found_in.get(self.bound.get(s, "")) == rid for s in self.movers)
-        kind = self.room_types.get(rid)
-        like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
-        share = EXPLORES_WHERE_THE_TASK_IS if task_here else EXPLORES_BEFORE_MOVING_ON
-        return (self.explored[rid] >= share, not task_here, -like, self.explored[rid],
-                math.dist(region.centroid, self.body.xy), rid)
+        def score(rid: str) -> tuple[bool, float, int, float, str]:
+            kind = self.room_types.get(rid)
+            like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
+            return (self.explored[rid] >= EXPLORES_BEFORE_MOVING_ON, -like, self.explored[rid],
+                    math.dist(graph.regions[rid].centroid, self.body.xy), rid)
+
+        open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
+        return min(open_regions, key=score) if open_regions else None
 
     def _put_down(self, held: str) -> _Step:
         return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(self._graph().robot.region_id), FLOOR),

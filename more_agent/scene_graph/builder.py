@@ -131,7 +131,7 @@ class SceneGraphBuilder:
             if iid not in voxels and iid not in self._remembered:
                 self._boxes[iid] = box
         known = sorted(i for i in set(voxels) | self._remembered | set(self._glimpsed) if i in self._instances)
-        doors = [voxels[i][:, :2] for i in known if self._instances[i].category == "door"]
+        doors = [voxels[i][:, :2] for i in known if i in voxels and self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)

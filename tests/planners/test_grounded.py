@@ -4,18 +4,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from more_agent.eval.episode import run_episode
-from more_agent.planners.base import EpisodeContext, default_planner, make_planner
-from more_agent.planners.grounded import EXPLORES_WHERE_THE_TASK_IS, GroundedPlanner
+from more_agent.planners.base import default_planner, make_planner
+from more_agent.planners.grounded import GroundedPlanner
 from more_agent.planners.room_types import likely_room_type
 from more_agent.planners.task_goal import task_goal
 from more_agent.records import EpisodeSpec
-from more_agent.scene_graph import SceneGraph
-from more_agent.scene_graph.model import Box3D, NavGraphData, ObjectNode, RegionNode, RobotNode
-from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
+from more_agent.sim.goals import GoalChecker, GoalStatus
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
@@ -45,6 +42,8 @@ def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen:
 
 
 def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
+    from more_agent.planners.base import EpisodeContext
+
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     actions = []
@@ -76,71 +75,3 @@ def test_room_types_from_furniture() -> None:
     assert likely_room_type(["fridge", "oven", "bottom_cabinet_no_top"]) == "kitchen"
     assert likely_room_type(["toilet"]) == "bathroom" and likely_room_type(["sofa", "coffee_table"]) == "living_room"
     assert likely_room_type(["unicorn"]) is None  # no room type lists it: no evidence
-
-
-def _two_room_graph(robot_xy: tuple[float, float]) -> SceneGraph:
-    """A region holding a checkout (typed a bathroom, as a store may be) and a kitchen, both with unexplored areas."""
-    def obj(label: str, category: str, region: str, xy: tuple[float, float]) -> ObjectNode:
-        box = Box3D(min=(xy[0] - 0.2, xy[1] - 0.2, 0.0), max=(xy[0] + 0.2, xy[1] + 0.2, 0.9))
-        return ObjectNode(id=label, category=category, instance_id=len(label), label=label, region_id=region,
-                          position=(xy[0], xy[1], 0.45), bbox=box, open=False if category == "fridge" else None)
-
-    objects = [obj("checkout_counter A", "checkout_counter", "region_0", (2.0, 2.0)),
-               obj("fridge A", "fridge", "region_1", (8.0, 2.0))]
-    regions = {
-        "region_0": RegionNode(id="region_0", centroid=(2.0, 2.0), nav_nodes=[0], object_ids=["checkout_counter A"],
-                               frontiers=[(0.0, 4.0)]),
-        "region_1": RegionNode(id="region_1", centroid=(8.0, 2.0), nav_nodes=[1], object_ids=["fridge A"],
-                               frontiers=[(9.0, 4.0)]),
-    }
-    nav = NavGraphData(node_xy=np.array([[2.0, 2.0], [8.0, 2.0]]), edges=np.array([[0, 1]]), weights=np.array([6.0]),
-                       door_edges=np.array([False]), node_region=["region_0", "region_1"])
-    return SceneGraph(step=0, robot=RobotNode(position=robot_xy, region_id="region_1" if robot_xy[0] > 5 else "region_0"),
-                      regions=regions, objects={o.label: o for o in objects}, relations=[], nav=nav)
-
-
-def test_search_stays_where_the_task_objects_were_found_before_the_likelier_room_type(kitchen: TaskInstance) -> None:
-    """An apple is missing; the kitchen is the likelier room type for it, but the ground beef the
-    goal also moves was found in the other region: that one is explored (up to its larger share)."""
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.graph = _two_room_graph((8.0, 2.0))
-    planner.room_types = {"region_0": "bathroom", "region_1": "kitchen"}
-    planner.explored.clear()
-    planner.found_in = {"checkout_counter A": "region_0", "fridge A": "region_1"}
-    cats = ["apple"]
-    planner.bound = {"cabinet.n.01_1": "checkout_counter A"}  # where things go is not where they are
-    assert planner._room_to_explore(cats) == "region_1"
-    planner.bound = {"pack__of__ground_beef.n.01_1": "checkout_counter A"}
-    assert planner._room_to_explore(cats) == "region_0"
-    planner.explored["region_0"] = EXPLORES_WHERE_THE_TASK_IS - 1
-    assert planner._room_to_explore(cats) == "region_0"
-    planner.explored["region_0"] = EXPLORES_WHERE_THE_TASK_IS  # its share is spent: the others come first
-    assert planner._room_to_explore(cats) == "region_1"
-
-
-def test_containers_here_are_opened_only_where_the_search_would_look_anyway(kitchen: TaskInstance) -> None:
-    """Looking for canned food from the kitchen: with nothing of the task seen elsewhere the kitchen's
-    closed fridge is opened first; once a task object stands in the other region, the robot goes
-    exploring there instead of opening what is near."""
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.graph = _two_room_graph((8.0, 2.0))
-    planner.room_types = {"region_0": "bathroom", "region_1": "kitchen"}
-    planner.names = {"region_0": "bathroom_0", "region_1": "kitchen_0"}
-    planner.seen = dict(planner.graph.objects)
-    planner.explored.clear()
-    planner.looked_into, planner.bound = set(), {}
-    wanted = Literal("inside", ("canned_food.n.01_1", "cabinet.n.01_1"))
-    step = planner._search(wanted, None)
-    assert (step.action.name, step.target) == ("go_to_and_open", "fridge A")
-    planner.found_in = {"checkout_counter A": "region_0"}
-    planner.bound = {"pack__of__ground_beef.n.01_1": "checkout_counter A"}  # found in the other region
-    step = planner._search(wanted, None)
-    assert (step.action.name, step.region) == ("explore", "region_0")
-    planner.explored.update({"region_0": EXPLORES_WHERE_THE_TASK_IS, "region_1": 3})  # both had their share
-    step = planner._search(wanted, None)
-    assert (step.action.name, step.target) == ("go_to_and_open", "fridge A")
-    planner.looked_into.add("fridge A")  # nothing closed left: explore again, where the task is
-    step = planner._search(wanted, None)
-    assert (step.action.name, step.region) == ("explore", "region_0")
