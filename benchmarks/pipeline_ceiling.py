@@ -11,7 +11,7 @@ blocked", ...) per 100 high-level steps, and the planner's median plan time per 
 one line per task set with the SR and TP gaps. It reads the worlds only through the harness, so it
 runs unchanged on other worlds. Run:
 ``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--workers 2] [--limit N]
-[--start random|random-area|task-room]`` (run folders ``<out>/<start>/<task set>/<planner>``).
+[--start random|random-area|task-room] [--no-distractors]`` (run folders ``<out>/<start>[-no-distractors]/<task set>/<planner>``).
 """
 
 from __future__ import annotations
@@ -59,6 +59,9 @@ def main() -> None:
     parser.add_argument("--planners", nargs="+", default=list(PLANNERS))
     parser.add_argument("--start", default="random", choices=["random", "random-area", "task-room"],
                         help="robot start of every episode (task-room: the worlds before random starts)")
+    parser.add_argument("--distractors", action=argparse.BooleanOptionalAction, default=True,
+                        help="add the scenes' own small objects (--no-distractors with --start task-room: the worlds "
+                             "before the harder-worlds issue, scene still drawn per seed)")
     args = parser.parse_args()
 
     for name in args.task_sets:
@@ -67,9 +70,9 @@ def main() -> None:
         for planner in args.planners:
             config = RunConfig(
                 planner=planner, tasks=tasks, seeds=list(range(args.seeds)), episode_fn="more_agent.eval.episode:run_episode",
-                workers=args.workers, start=args.start, more_agent_version=__version__,
+                workers=args.workers, start=args.start, distractors=args.distractors, more_agent_version=__version__,
             )
-            run_dir = args.out / args.start / name / planner
+            run_dir = args.out / (args.start if args.distractors else f"{args.start}-no-distractors") / name / planner
             records = evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
             write_reports([SourcedRecord(r, run_dir) for r in records], run_dir, title=f"{planner} on {name}")
             results[planner] = records

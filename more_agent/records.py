@@ -145,3 +145,6 @@ class EpisodeSpec(FrozenModel):
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
     start: str = Field(default="random", description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.")
+    distractors: bool = Field(
+        default=True, description="Add the scene's own small objects as distractor items (False: only the task's objects)."
+    )

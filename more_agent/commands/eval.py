@@ -24,6 +24,9 @@ def eval_(
     start: Annotated[str, typer.Option(
         help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
     )] = "random",
+    distractors: Annotated[bool, typer.Option(
+        help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
+    )] = True,
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -84,6 +87,7 @@ def eval_(
         seeds=list(range(seeds)),
         scene=scene,
         start=start,
+        distractors=distractors,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

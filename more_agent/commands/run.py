@@ -75,6 +75,9 @@ def run(
     start: Annotated[str, typer.Option(
         help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
     )] = "random",
+    distractors: Annotated[bool, typer.Option(
+        help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
+    )] = True,
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
@@ -103,7 +106,7 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start)
+    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors)
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,

@@ -110,7 +110,10 @@ def _is_file(path: Path) -> bool:
 def config_specs(config: RunConfig) -> list[EpisodeSpec]:
     """Every episode of a run: tasks x seeds, task-major."""
     return [
-        EpisodeSpec(task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start)
+        EpisodeSpec(
+            task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start,
+            distractors=config.distractors,
+        )
         for t in config.tasks
         for s in config.seeds
     ]

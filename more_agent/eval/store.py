@@ -38,6 +38,7 @@ class RunConfig(BaseModel):
     seeds: list[int] = Field(default_factory=list, description="Seeds run for every task.")
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
     start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
+    distractors: bool = Field(default=True, description="Whether every episode's world holds the scene's own small objects.")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
@@ -49,7 +50,7 @@ def redact(spec: str | None) -> str | None:
     return None if spec is None else redact_text(spec)
 
 
-MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "episode_fn")
+MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "episode_fn")
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 

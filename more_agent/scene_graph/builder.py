@@ -42,6 +42,9 @@ from more_agent.sim.scene import FREE_SPACE_CLASSES
 STRUCTURE_CATEGORIES = ("wall", "window", "door")
 """Classes that block line of sight for object assignment."""
 
+GLIMPSE_MAX_PIXELS = 400
+"""Instances covering at most this many pixels of a frame also get a box from those pixels (``_glimpse``)."""
+
 
 class SceneGraphBuilder:
     """Incremental scene-graph builder over posed depth + semantic + instance frames."""
@@ -61,6 +64,8 @@ class SceneGraphBuilder:
         self._viewpoints: dict[int, dict[tuple[int, int], tuple[float, float]]] = {}
         self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._remembered: set[int] = set()
+        self._glimpsed: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        """Instance id -> box of its pixels when last in view small (used while the voxel map has none of it)."""
         self._anchors: dict[str, np.ndarray] = {}
         self._next_region = 0
         self._room_labels: dict[str, str] = {}
@@ -90,11 +95,13 @@ class SceneGraphBuilder:
                     self._set_box(iid, removed)
             if info.held:
                 self._remembered.discard(iid)
+                self._glimpsed.pop(iid, None)
             if info.category == "door" and previous is not None and previous.open is not None and info.open != previous.open:
                 self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks (or is new)
             self._instances[iid] = info
         held = [iid for iid, info in self._instances.items() if info.held]
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
+        self._glimpse(depth, instance, K, T_world_cam, held)
         xy = (float(robot_xy[0]), float(robot_xy[1]))
         key = (round(xy[0] / self.config.viewpoint_spacing_m), round(xy[1] / self.config.viewpoint_spacing_m))
         for iid in np.unique(instance[np.isfinite(depth)]).tolist():
@@ -121,8 +128,11 @@ class SceneGraphBuilder:
         voxels = self.voxels.instance_voxels()
         for iid, pts in voxels.items():
             self._set_box(iid, pts)
-        known = sorted(i for i in set(voxels) | self._remembered if i in self._instances)
-        doors = [voxels[i][:, :2] for i in known if self._instances[i].category == "door"]
+        for iid, box in self._glimpsed.items():
+            if iid not in voxels and iid not in self._remembered:
+                self._boxes[iid] = box
+        known = sorted(i for i in set(voxels) | self._remembered | set(self._glimpsed) if i in self._instances)
+        doors = [voxels[i][:, :2] for i in known if i in voxels and self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
@@ -134,6 +144,28 @@ class SceneGraphBuilder:
         return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, grid)
 
     # ---------------------------------------------------------------- helpers
+    def _glimpse(self, depth: np.ndarray, instance: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray,
+                 held: Sequence[int]) -> None:
+        """Box the small instances in view from their own pixels. A small item on a support shares its
+        voxels with the support's surface (7.5 cm voxels, an egg is 5 cm tall), and the surface's hits
+        overwrite it: without this the map loses it even while the robot looks at it."""
+        valid = np.isfinite(depth) & (instance > 0)
+        counts = np.bincount(instance[valid].ravel())
+        small = np.flatnonzero((counts > 0) & (counts <= GLIMPSE_MAX_PIXELS))
+        small = small[~np.isin(small, held)]
+        if small.size == 0:
+            return
+        v, u = np.nonzero(valid & np.isin(instance, small))
+        d = depth[v, u].astype(float)
+        cam = np.stack([(u + 0.5 - K[0, 2]) / K[0, 0] * d, (v + 0.5 - K[1, 2]) / K[1, 1] * d, d], axis=1)
+        inside = np.einsum("ij,ij->i", cam, cam) <= self.config.max_range_m ** 2
+        pts = cam[inside] @ T_world_cam[:3, :3].T + T_world_cam[:3, 3]
+        ids = instance[v, u][inside]
+        half = self.config.resolution_m / 2
+        for iid in np.unique(ids).tolist():
+            mine = pts[ids == iid]
+            self._glimpsed[iid] = (mine.min(0) - half, mine.max(0) + half)
+
     def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
         half = self.config.resolution_m / 2
         self._boxes[iid] = (voxel_centres.min(0) - half, voxel_centres.max(0) + half)

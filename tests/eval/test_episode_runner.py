@@ -5,7 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
+from more_agent.eval.harness import config_specs
 from more_agent.eval.metrics import rtp
+from more_agent.eval.store import RunConfig
 from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.oracle import OraclePlanner
 from more_agent.planners.policies import Embodiment
@@ -42,6 +44,10 @@ def test_record_says_how_hard_the_world_was() -> None:
     assert task_room is not None and task_room.start_room in task_room.task_rooms
     store = run_episode(EpisodeSpec(task="bag_groceries", scene="grocery_store_asian", seed=0, planner="oracle"))
     assert store.world_stats is not None and store.world_stats.objects >= 500 and store.world_stats.distractors >= 400
+    bare_spec = config_specs(RunConfig(planner="oracle", tasks=["bag_groceries"], seeds=[0], scene="grocery_store_asian",
+                                       episode_fn="x:y", distractors=False))[0]
+    bare = run_episode(bare_spec).world_stats  # --no-distractors: the worlds before the scenes' own objects came in
+    assert bare is not None and bare.distractors == 0 and bare.objects <= store.world_stats.objects - 400
 
 
 NOTHING_HAPPENS = ActionResult(ok=False, reason=None, feedback="nothing happens")
