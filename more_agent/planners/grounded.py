@@ -17,10 +17,11 @@ Every step (MPC style) it rebuilds the scene graph and:
    closed container before placing inside, grasp, place, put down what the hand holds but does
    not need;
 4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
-   at most while there is a room to explore), explores the
-   room most likely to hold what is missing (BEHAVIOR-1K room inventories; rooms explored three
-   times yield to the others; then the room explored least often, then the nearest), then opens other containers, then closed doors; it gives up with
-   ``done`` when nothing is left to try.
+   at most while there is a room to explore), explores the room most likely to hold the missing
+   furniture (BEHAVIOR-1K room inventories), a room whose explores still reveal new objects before
+   the others, then the one explored least often, the nearest; each explore drives to the frontiers
+   farthest from the robot's path. A room whose last two explores revealed nothing new yields to the
+   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
@@ -31,19 +32,23 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass
+
+import numpy as np
 
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.language import room_names
 from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
-from more_agent.planners.room_types import category_likelihood, likely_room_type
+from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type
 from more_agent.planners.task_goal import TaskGoal, task_goal
 from more_agent.records import LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.goals import Literal
+from more_agent.sim.navgrid import XY
 
 FLOOR = "floor"
 """Object argument of a placement on the floor of a room."""
@@ -54,8 +59,11 @@ MAX_FAILURES = 2
 OPENS_BEFORE_EXPLORING = 3
 """Containers opened to look inside, one after the other, before the search explores again."""
 
-EXPLORES_BEFORE_MOVING_ON = 3
-"""A room explored this often yields to rooms explored less, however likely it is to hold what is missing."""
+FRUITLESS_EXPLORES = 2
+"""A room whose last explores, this many in a row, revealed no new object yields to containers, doors, other rooms."""
+
+FAR_FRONTIER_SHARE = 0.5
+"""Explore goes to the frontiers at least this share as far from the robot's path as the farthest one."""
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
@@ -73,6 +81,8 @@ class _Step:
     """Label of the object acted on (None for explore / floor placement)."""
     region: str | None = None
     """Region to explore or to put the held item down in."""
+    frontiers: tuple[XY, ...] | None = None
+    """The region's frontiers to explore (None: all of them)."""
 
 
 class GroundedPlanner:
@@ -106,7 +116,9 @@ class GroundedPlanner:
         self.failures: Counter[tuple[str, tuple[str, ...], str]] = Counter()
         self.opened_in_a_row = 0
         self.explored: Counter[str] = Counter()
-        """Region id -> explore() calls so far: rooms are explored breadth first, not one frontier after another."""
+        """Region id -> explore() calls so far."""
+        self.fruitless: Counter[str] = Counter()
+        """Region id -> explore() calls in a row that revealed no new object (``FRUITLESS_EXPLORES``)."""
         self.room_types: dict[str, str] = {}
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
@@ -324,14 +336,16 @@ class GroundedPlanner:
         region = self._room_to_explore(missing)
         if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
             return self._open_to_look(closed[0].label, held, note)
-        if region is not None:
-            return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region)
+        if region is not None and not self._stale(region):
+            return self._explore_step(region, note)
         if closed:
             return self._open_to_look(closed[0].label, held, note)
         doors = sorted((o for o in graph.objects.values() if o.category == "door" and o.open is False
                         and o.label not in self.dropped), key=lambda o: math.dist(o.position[:2], self.body.xy))
         if doors:
             return self._open_to_look(doors[0].label, held, note)
+        if region is not None:
+            return self._explore_step(region, note)
         why = f"{note}: nothing left to explore or open"
         return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
@@ -341,18 +355,30 @@ class GroundedPlanner:
         return self._object_step("go_to_and_open", label, note)
 
     def _room_to_explore(self, missing: list[str]) -> str | None:
-        """The region with unexplored areas most likely to hold the missing furniture, nearest first."""
+        """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
+        new last; then the room most likely to hold the missing furniture; then a room whose explores
+        still reveal new objects before one not explored yet (a garden or a store is searched through,
+        not left after a few metres); then the least explored, the nearest."""
         graph = self._graph()
-        cats = [c for s in missing for c in self.goal.categories.get(s, ())]
+        cats = [c for s in missing for c in self.goal.categories.get(s, ()) if is_furniture(c)]
 
-        def score(rid: str) -> tuple[bool, float, int, float, str]:
+        def score(rid: str) -> tuple[bool, float, bool, int, float, str]:
             kind = self.room_types.get(rid)
             like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
-            return (self.explored[rid] >= EXPLORES_BEFORE_MOVING_ON, -like, self.explored[rid],
+            productive = self.explored[rid] > 0 and self.fruitless[rid] == 0
+            return (self._stale(rid), -like, not productive, self.explored[rid],
                     math.dist(graph.regions[rid].centroid, self.body.xy), rid)
 
         open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
         return min(open_regions, key=score) if open_regions else None
+
+    def _stale(self, region: str) -> bool:
+        """Whether the region's last explores revealed no object not seen before."""
+        return self.fruitless[region] >= FRUITLESS_EXPLORES
+
+    def _explore_step(self, region: str, note: str) -> _Step:
+        return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region,
+                     frontiers=far_frontiers(self._graph().frontiers(region), self.body.trajectory))
 
     def _put_down(self, held: str) -> _Step:
         return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(self._graph().robot.region_id), FLOOR),
@@ -374,11 +400,16 @@ class GroundedPlanner:
         if action.name == DONE or step is None:
             return run_skill(body, graph, DONE, None)
         held = graph.held_object
-        target = graph.objects[step.target] if step.target is not None else Area(action.arguments[0], step.region)
+        if step.target is not None:
+            target: ObjectNode | Area = graph.objects[step.target]
+        else:
+            target = Area(action.arguments[0], step.region, step.frontiers)
+        known = len(body.observed)
         result = run_skill(body, graph, action.name, target)
         if action.name == "explore":
             assert step.region is not None
             self.explored[step.region] += 1
+            self.fruitless[step.region] = 0 if len(body.observed) > known else self.fruitless[step.region] + 1
         elif step.target is None and result.ok and held is not None:  # put on a floor
             region = step.region or graph.robot.region_id
             self.relation[held.label] = ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
@@ -414,3 +445,14 @@ class GroundedPlanner:
 
 def _on_floor(rel: Relation | None) -> bool:
     return rel is not None and rel[1].startswith(f"{FLOOR} ")
+
+
+def far_frontiers(frontiers: Sequence[XY], path: Sequence[XY]) -> tuple[XY, ...]:
+    """The frontiers far from everywhere the robot has been (``FAR_FRONTIER_SHARE``): explore() drives
+    to the nearest of them, so a garden or a store is crossed instead of covered a few metres at a time."""
+    if not frontiers:
+        return ()
+    points = np.asarray(frontiers, dtype=float)
+    seen = np.asarray(path[::4] or [(math.inf, math.inf)], dtype=float)  # every 4th point: 0.3 m apart
+    gap = np.sqrt(((points[:, None, :] - seen[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    return tuple(f for f, d in zip(frontiers, gap) if d >= FAR_FRONTIER_SHARE * gap.max())

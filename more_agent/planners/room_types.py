@@ -31,6 +31,11 @@ def room_type_counts() -> dict[str, Counter[str]]:
     return counts
 
 
+def is_furniture(category: str) -> bool:
+    """Whether some room type lists ``category`` (else its likelihood only reflects room sizes)."""
+    return any(category in counts for counts in room_type_counts().values())
+
+
 def category_likelihood(category: str, room_type: str) -> float:
     """Smoothed share of ``room_type``'s furniture that is ``category`` (0 for unknown room types)."""
     counts = room_type_counts().get(room_type)
@@ -43,7 +48,7 @@ def category_likelihood(category: str, room_type: str) -> float:
 def likely_room_type(categories: Iterable[str]) -> str | None:
     """The room type that best explains the furniture categories seen (naive Bayes, uniform prior);
     None when none of them is furniture any room type lists."""
-    seen = [c for c in categories if any(c in counts for counts in room_type_counts().values())]
+    seen = [c for c in categories if is_furniture(c)]
     if not seen:
         return None
     return max(sorted(room_type_counts()), key=lambda t: sum(math.log(category_likelihood(c, t)) for c in seen))

@@ -8,8 +8,8 @@ import pytest
 
 from more_agent.eval.episode import run_episode
 from more_agent.planners.base import default_planner, make_planner
-from more_agent.planners.grounded import GroundedPlanner
-from more_agent.planners.room_types import likely_room_type
+from more_agent.planners.grounded import FRUITLESS_EXPLORES, OPENS_BEFORE_EXPLORING, GroundedPlanner, far_frontiers
+from more_agent.planners.room_types import is_furniture, likely_room_type
 from more_agent.planners.task_goal import task_goal
 from more_agent.records import EpisodeSpec
 from more_agent.sim.goals import GoalChecker, GoalStatus
@@ -75,3 +75,31 @@ def test_room_types_from_furniture() -> None:
     assert likely_room_type(["fridge", "oven", "bottom_cabinet_no_top"]) == "kitchen"
     assert likely_room_type(["toilet"]) == "bathroom" and likely_room_type(["sofa", "coffee_table"]) == "living_room"
     assert likely_room_type(["unicorn"]) is None  # no room type lists it: no evidence
+
+
+def test_explore_goes_to_the_frontiers_far_from_the_robots_path() -> None:
+    frontiers = [(1.0, 0.0), (10.0, 0.0), (0.0, 9.0), (4.0, 0.0)]
+    path = [(0.0, 0.0), (0.5, 0.0)]
+    assert far_frontiers(frontiers, path) == ((10.0, 0.0), (0.0, 9.0))  # 4 m is under half the farthest gap
+    assert far_frontiers([], path) == ()
+
+
+def test_unlisted_categories_do_not_rank_rooms() -> None:
+    assert is_furniture("fridge") and not is_furniture("tennis_racket")
+
+
+def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None:
+    from more_agent.planners.base import EpisodeContext
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
+    lit = planner.literals[0]
+    step = planner._search(lit, None)
+    assert step.action.name == "explore" and step.frontiers
+    planner.fruitless[step.region] = FRUITLESS_EXPLORES - 1
+    assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
+    planner.fruitless[step.region] = FRUITLESS_EXPLORES  # its last explores showed nothing new
+    assert planner._search(lit, None).action.name == "go_to_and_open"
