@@ -19,16 +19,14 @@ TOLERANCE_M = 0.01
 
 def enclosing_object(world: World, name: str) -> str | None:
     """Name of an object, not among ``name``'s supports, whose box encloses ``name``'s box; else None."""
-    obj = world.objects[name]
-    lo, hi = obj.box()
+    lo, hi = world.objects[name].box()
     supports = {parent.name for parent, _ in world.ancestors(name)}
-    for other in world.objects.values():
-        if other.name == name or other.name in supports or other.kind == "floor":
-            continue
-        olo, ohi = other.box()
-        if np.all(lo >= olo - TOLERANCE_M) and np.all(hi <= ohi + TOLERANCE_M):
-            return other.name
-    return None
+    others = [o for o in world.objects.values() if o.name != name and o.name not in supports and o.kind != "floor"]
+    if not others:
+        return None
+    centers, halves = np.array([o.center for o in others]), np.array([o.size for o in others]) / 2
+    encloses = np.all(lo >= centers - halves - TOLERANCE_M, axis=1) & np.all(hi <= centers + halves + TOLERANCE_M, axis=1)
+    return next((o.name for o, e in zip(others, encloses) if e), None)
 
 
 def out_of_reach(world: World, name: str) -> bool:

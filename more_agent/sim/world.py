@@ -391,12 +391,13 @@ class World:
         lo3, hi3 = np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + obj.size[2]])
         skip = {obj.name, support.name, self.robot.held} | {o.name for o in self.descendants(obj.name)}
         skip |= {parent.name for parent, _ in self.ancestors(support.name)}
+        objs = [o for o in self.objects.values() if o.kind != "floor" and o.name not in skip]
+        if not objs:
+            return []
+        centers, halves = np.array([o.center for o in objs]), np.array([o.size for o in objs]) / 2
         eps = 1e-5  # boxes that merely touch (a card under a barrel's band) do not overlap
-        return [
-            o for o in self.objects.values()
-            if o.kind != "floor" and o.name not in skip
-            and np.all(o.center - o.size / 2 < hi3 - eps) and np.all(o.center + o.size / 2 > lo3 + eps)
-        ]
+        meets = np.all(centers - halves < hi3 - eps, axis=1) & np.all(centers + halves > lo3 + eps, axis=1)
+        return [o for o, m in zip(objs, meets) if m]
 
 
 def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:
