@@ -409,11 +409,16 @@ def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:
 
 def _top_level(support: WorldObject) -> float:
     """Height items rest at on top of ``support``: its top, or for a levelled support taller than the
-    arm reaches (``LEVELLED_CATEGORIES``) its highest inner level at most ``REACH_TOP_M`` high."""
+    arm reaches (``LEVELLED_CATEGORIES``) its highest inner level at most ``REACH_TOP_M`` high. Inner
+    levels lie ``LEVEL_STEP_M`` apart from the bottom slab up, a step or more below the top; a
+    support with none within reach (a single board hung high) keeps its top."""
     if support.category not in LEVELLED_CATEGORIES or support.top <= REACH_TOP_M:
         return support.top
     first = support.bottom + SLAB_FRACTION * support.size[2]
-    return first + LEVEL_STEP_M * max(np.floor((REACH_TOP_M - first) / LEVEL_STEP_M), 0.0)
+    highest = min(REACH_TOP_M, support.top - LEVEL_STEP_M)
+    if highest < first:
+        return support.top
+    return first + LEVEL_STEP_M * np.floor((highest - first) / LEVEL_STEP_M)
 
 
 def _alpha(i: int) -> str:

@@ -91,3 +91,11 @@ def test_a_tall_shelf_takes_items_on_top_at_its_highest_level_within_reach() -> 
     assert world.objects["jar_0"].bottom <= REACH_TOP_M < shelf.top
     assert world.objects["jar_0"].bottom > REACH_TOP_M - 0.4  # the highest level, not the lowest
     assert world.objects["jar_1"].bottom == low.top  # a low support keeps its top
+
+
+def test_a_single_board_hung_high_keeps_items_on_its_top() -> None:
+    world = _world()
+    board = _add(world, "shelf_0", "shelf", "furniture", (0.0, 0.0, 2.15), (1.0, 0.3, 0.1))
+    _add(world, "jar_0", "jar", "item", (5.0, 5.0, 0.0), (0.1, 0.1, 0.1))
+    world.place("jar_0", board.name, "ontop")
+    assert world.objects["jar_0"].bottom == board.top and enclosing_object(world, "jar_0") is None
