@@ -10,7 +10,9 @@ Steps (all deterministic for a given task, scene and seed):
    ('apple.n.01_1' -> 'apple_1').
 4. Placement literals run supports first (topological order): ``ontop``/``inside`` rest the item on
    / in its support (on a floor: at a free spot sampled against furniture, walls, doors and other
-   floor items); ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
+   floor items; elsewhere at a free slot that no other box reaches into, ``sim.world.free_slot``:
+   not inside a TV standing on the same table, on the highest level within reach of a tall shelf);
+   ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
    ``touching`` on the floor beside the other object, or on the same support when that object is
    not on a floor. Openable containers that receive items are closed unless an ``open`` literal
    says otherwise; then ``open`` / ``not open`` literals set articulation.
@@ -361,7 +363,7 @@ class _Builder:
         if pred in ("ontop", "inside") and support.kind == "floor":
             self._on_free_floor(a, b, area=self.areas.get(atom[2]))
         elif pred in ("ontop", "inside"):
-            self.world.place(a, b, pred)
+            self._on_support(a, b, pred, atom)
             if pred == "inside" and support.openable and atom[2] not in opened:
                 support.is_open = False
         elif pred == "under":
@@ -370,7 +372,14 @@ class _Builder:
         elif support.parent is None or self.world.objects[support.parent].kind == "floor" or support.kind != "item":
             self._on_free_floor(a, floor_name(support.room), near=support)
         else:
-            self.world.place(a, support.parent, support.relation or "ontop")
+            self._on_support(a, support.parent, support.relation or "ontop", atom)
+
+    def _on_support(self, name: str, support: str, relation: str, atom: ParsedLiteral) -> None:
+        """Rest ``name`` at a free slot of ``support``, on the items already there when it is full;
+        unlike a magic place action, never where another box already is (a full closed container
+        fails this scene)."""
+        if not self.world.place_if_room(name, support, relation, stack=True):
+            raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 
     def _default_floor(self) -> str:
         return self.agent_floor or floor_name(self.world.scene.rooms[0].id)

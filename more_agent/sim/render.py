@@ -15,7 +15,7 @@ What is drawn (docs/sensors.md):
   the camera's field of view;
 - furniture and items as boxes with their category and instance id; items only while
   ``world.is_observable`` (not held, not inside a closed container). An open container, or a
-  non-openable one with something inside, is a cage: bottom and top slabs of
+  non-openable one with something inside (or on an inner shelf level), is a cage: bottom and top slabs of
   ``SLAB_FRACTION * height`` and four thin corner posts, so its contents show while its observed
   extent stays its full box. A closed container is solid, which hides its contents.
 No ceiling; no robot body.
@@ -106,7 +106,10 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
     for patch in world.scene.ground_patches:
         x0, y0, x1, y1 = patch.bounds
         boxes.append((np.array([x0, y0, -0.01]), np.array([x1, y1, PATCH_TOP_M]), world.semantic_id(patch.ground), 0))
-    holds_inside = {o.parent for o in world.objects.values() if o.relation == "inside"}
+    holds_inside = {  # in it, or on one of its inner levels (world.LEVELLED_CATEGORIES)
+        o.parent for o in world.objects.values()
+        if o.parent is not None and (o.relation == "inside" or o.bottom < world.objects[o.parent].top - 1e-6)
+    }
     for obj in world.objects.values():
         sem = world.semantic_id(obj.category)
         lo, hi = obj.box()

@@ -31,6 +31,20 @@ SLOT_GAP_M = 0.02
 CARRY_HEIGHT_M = 1.0
 """Height of a held item's centre, above the robot base."""
 
+REACH_TOP_M = 1.6
+"""Highest surface the arm places on (the Fetch arm with its torso lowered, like the 1.2 m camera, which
+sees items there from about a metre away). A support with inner levels whose top is higher takes
+items on top on its highest level at most this high (``support_surface``)."""
+
+LEVELLED_CATEGORIES = frozenset(
+    """shelf bookcase grocery_shelf commercial_kitchen_shelf candy_dispenser_shelf dry_food_dispenser_shelf
+    shoe_rack magazine_rack snack_rack""".split()
+)
+"""Supports with inner shelf levels: BEHAVIOR-1K's ``ontop`` holds on any of their levels."""
+
+LEVEL_STEP_M = 0.4
+"""Spacing of the inner levels of a ``LEVELLED_CATEGORIES`` support, from its bottom slab up."""
+
 
 def floor_name(room_id: str) -> str:
     """Name of the floor object of a room (every room has one)."""
@@ -269,10 +283,11 @@ class World:
         self.version += 1
         self.layout_version += 1
 
-    def place_if_room(self, name: str, parent: str, relation: Relation) -> bool:
-        """Like ``place``, but only where a free slot exists; False (nothing changed) when there is none."""
+    def place_if_room(self, name: str, parent: str, relation: Relation, *, stack: bool = False) -> bool:
+        """Like ``place``, but only where a free slot exists (``free_slot``); False (nothing changed)
+        when there is none."""
         obj, support = self.objects[name], self.objects[parent]
-        slot = self.free_slot(obj, support, relation)
+        slot = self.free_slot(obj, support, relation, stack=stack)
         if slot is None:
             return False
         obj.parent, obj.relation, obj.room = parent, relation, support.room
@@ -328,41 +343,82 @@ class World:
         """(footprint min xy, footprint max xy, surface z) where items rest in / on ``support``."""
         lo, hi = support.box()
         if relation == "ontop":
-            return lo[:2], hi[:2], support.top
+            return lo[:2], hi[:2], _top_level(support)
         slab = SLAB_FRACTION * support.size[2]
         margin = np.minimum(0.05, support.size[:2] * 0.1)
         return lo[:2] + margin, hi[:2] - margin, support.bottom + slab
 
     def _free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray:
-        """Centre of the first free slot on the support (``free_slot``), else the support's centre:
-        magic placement, like the paper's, never fails for lack of room."""
-        slot = self.free_slot(obj, support, relation)
+        """Centre of the first free slot on the support, stacking when it is full (``free_slot``), else
+        the support's centre: magic placement, like the paper's, never fails for lack of room."""
+        slot = self.free_slot(obj, support, relation, stack=True)
         if slot is not None:
             return slot
         lo, hi, z = self.support_surface(support, relation)
         cx, cy = (lo + hi) / 2
         return np.array([cx, cy, z + obj.size[2] / 2])
 
-    def free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray | None:
-        """Centre of the first slot on the support, in reading order, overlapping none of its other
-        items; None when the item is larger than the support or the support is full."""
+    def free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False) -> np.ndarray | None:
+        """Centre of the first slot on the support, in reading order, where the item's box meets no other
+        box (``_obstacles``); with ``stack``, when the surface is full, on the next layer up (on the
+        items already there; in a closed-lid container only while it fits under the lid). An item
+        wider than the surface overhangs it, centred. None when there is no such slot."""
         lo, hi, z = self.support_surface(support, relation)
         half = obj.size[:2] / 2 + SLOT_GAP_M / 2
-        xs = np.arange(lo[0] + half[0], hi[0] - half[0] + 1e-9, 2 * half[0])
-        ys = np.arange(lo[1] + half[1], hi[1] - half[1] + 1e-9, 2 * half[1])
-        if not len(xs) or not len(ys):
-            return None
-        others = [o for o in self.children(support.name, relation) if o.name != obj.name]
+        xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
         gx, gy = np.meshgrid(xs, ys)  # rows follow y: reading order is row by row
         slots = np.stack([gx.ravel(), gy.ravel()], axis=1)
-        if others:
-            centers = np.array([o.center[:2] for o in others])
-            reach = half + np.array([o.size[:2] / 2 for o in others])
-            overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
-            slots = slots[~overlap]
-        if not len(slots):
-            return None
-        return np.array([slots[0, 0], slots[0, 1], z + obj.size[2] / 2])
+        while True:
+            others = self._obstacles(obj, support, lo, hi, z)
+            free = slots
+            if others:
+                centers = np.array([o.center[:2] for o in others])
+                reach = half + np.array([o.size[:2] / 2 for o in others])
+                overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
+                free = slots[~overlap]
+            if len(free):
+                return np.array([free[0, 0], free[0, 1], z + obj.size[2] / 2])
+            layer = [o.top for o in others if o.parent == support.name and o.relation == relation]
+            lidded = relation == "inside" and support.openable
+            if not stack or not layer or (lidded and max(layer) + obj.size[2] > support.top):
+                return None
+            z = max(layer)
+
+    def _obstacles(self, obj: WorldObject, support: WorldObject, lo: np.ndarray, hi: np.ndarray, z: float) -> list[WorldObject]:
+        """Objects in the space an item of ``obj``'s height would take on the surface (``lo``, ``hi``, ``z``):
+        items already there and anything else standing in it (a TV on the coffee table, a shelf
+        hung above a desk), but not the supports of ``support`` nor ``obj``, its load or the held item."""
+        lo3, hi3 = np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + obj.size[2]])
+        skip = {obj.name, support.name, self.robot.held} | {o.name for o in self.descendants(obj.name)}
+        skip |= {parent.name for parent, _ in self.ancestors(support.name)}
+        objs = [o for o in self.objects.values() if o.kind != "floor" and o.name not in skip]
+        if not objs:
+            return []
+        centers, halves = np.array([o.center for o in objs]), np.array([o.size for o in objs]) / 2
+        eps = 1e-5  # boxes that merely touch (a card under a barrel's band) do not overlap
+        meets = np.all(centers - halves < hi3 - eps, axis=1) & np.all(centers + halves > lo3 + eps, axis=1)
+        return [o for o, m in zip(objs, meets) if m]
+
+
+def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:
+    """Slot centres along one axis of a surface from ``lo`` to ``hi`` for an item of half-width ``half``;
+    the surface's centre alone when the item is wider."""
+    centres = np.arange(lo + half, hi - half + 1e-9, 2 * half)
+    return centres if len(centres) else np.array([(lo + hi) / 2])
+
+
+def _top_level(support: WorldObject) -> float:
+    """Height items rest at on top of ``support``: its top, or for a levelled support taller than the
+    arm reaches (``LEVELLED_CATEGORIES``) its highest inner level at most ``REACH_TOP_M`` high. Inner
+    levels lie ``LEVEL_STEP_M`` apart from the bottom slab up, a step or more below the top; a
+    support with none within reach (a single board hung high) keeps its top."""
+    if support.category not in LEVELLED_CATEGORIES or support.top <= REACH_TOP_M:
+        return support.top
+    first = support.bottom + SLAB_FRACTION * support.size[2]
+    highest = min(REACH_TOP_M, support.top - LEVEL_STEP_M)
+    if highest < first:
+        return support.top
+    return first + LEVEL_STEP_M * np.floor((highest - first) / LEVEL_STEP_M)
 
 
 def _alpha(i: int) -> str:
