@@ -43,6 +43,9 @@ def row(task_set_name: str, planner: str, records: list[EpisodeRecord]) -> dict[
     return {
         "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
         "sr": round(100 * s.SR.mean, 1), "tp": round(100 * s.TP.mean, 1),
+        "successes_per_seed": {seed: sum(r.success for r in records if r.seed == seed)
+                               for seed in sorted({r.seed for r in records})},
+        "high_level_steps": steps,
         "causes": dict(sorted(cause_counts(records).items())),
         "reach_failures_per_100_steps": round(100 * reach / steps, 2) if steps else None,
         "median_plan_ms_per_step": round(statistics.median(plan_ms), 3) if plan_ms else None,

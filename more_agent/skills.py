@@ -73,7 +73,7 @@ SKILLS: tuple[Skill, ...] = (
 
 SKILLS_BY_NAME: dict[str, Skill] = {s.name: s for s in SKILLS}
 
-MANIPULATION_VERBS: tuple[str, ...] = tuple(s.world_action for s in SKILLS if s.subpolicy == "go_to_and" and s.world_action)
+MANIPULATION_VERBS: tuple[str, ...] = tuple(s.world_action for s in SKILLS if s.changes_world and s.world_action)
 """The world actions of the go-to-and-act skills: open, close, grasp, place_inside, place_ontop."""
 
 

@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import TypeVar
+from typing import Annotated, TypeVar
 
 import typer
 from rich.console import Console
@@ -34,6 +34,16 @@ EXIT_RETRYABLE = 75
 EXIT_INTERRUPTED = 130
 
 F = TypeVar("F", bound=Callable[..., object])
+
+StartOption = Annotated[str, typer.Option(
+    help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+)]
+"""``--start`` of ``run`` and ``eval``."""
+
+DistractorsOption = Annotated[bool, typer.Option(
+    help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
+)]
+"""``--distractors/--no-distractors`` of ``run`` and ``eval``."""
 
 
 class _SafeStderrHandler(logging.Handler):

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from more_agent.commands._common import EXIT_RETRYABLE, err_console, user_errors_exit_2
+from more_agent.commands._common import EXIT_RETRYABLE, DistractorsOption, StartOption, err_console, user_errors_exit_2
 from more_agent.errors import UserError
 
 
@@ -21,12 +21,8 @@ def eval_(
     scene: Annotated[str | None, typer.Option(
         help="Scene for every task (default: drawn per episode among each task's suitable scenes)."
     )] = None,
-    start: Annotated[str, typer.Option(
-        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
-    )] = "random",
-    distractors: Annotated[bool, typer.Option(
-        help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
-    )] = True,
+    start: StartOption = "random",
+    distractors: DistractorsOption = True,
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")

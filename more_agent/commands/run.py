@@ -14,7 +14,14 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from more_agent.commands._common import EXIT_FAILED, EXIT_RETRYABLE, console, user_errors_exit_2
+from more_agent.commands._common import (
+    EXIT_FAILED,
+    EXIT_RETRYABLE,
+    DistractorsOption,
+    StartOption,
+    console,
+    user_errors_exit_2,
+)
 from more_agent.errors import check_writable_dir
 from more_agent.records import EpisodeRecord, EpisodeSpec
 
@@ -72,12 +79,8 @@ def run(
         help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
     )] = None,
     seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation, instantiation and start pose.")] = 0,
-    start: Annotated[str, typer.Option(
-        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
-    )] = "random",
-    distractors: Annotated[bool, typer.Option(
-        help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
-    )] = True,
+    start: StartOption = "random",
+    distractors: DistractorsOption = True,
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,

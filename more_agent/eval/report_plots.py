@@ -69,18 +69,17 @@ def plot_metrics(records: Sequence[EpisodeRecord], path: Path) -> Path:
 def plot_task_heatmap(records: Sequence[EpisodeRecord], path: Path) -> Path:
     """Success rate per (task, system); blank where a system did not run a task."""
     cells = by_task(records)
-    systems = list(by_system(records))
+    systems = list(group_by(records, system_label))
     tasks = sorted({t for _, t in cells})
     sr = np.full((len(tasks), len(systems)), np.nan)
     for (system, task), s in cells.items():
         sr[tasks.index(task), systems.index(system)] = 100 * s.SR.mean
     fig, ax = plt.subplots(figsize=(4.0 + 1.0 * len(systems), 1.6 + 0.2 * len(tasks)))
     im = ax.imshow(np.ma.masked_invalid(sr), cmap="RdYlGn", vmin=0, vmax=100, aspect="auto", interpolation="nearest")
-    ax.set_xticks(range(len(systems)), systems, rotation=30, ha="right", fontsize=8)
+    ax.set_xticks(range(len(systems)), systems, rotation=30, ha="left", fontsize=8)
     ax.set_yticks(range(len(tasks)), tasks, fontsize=7)
     ax.xaxis.tick_top()
     ax.tick_params(axis="x", labeltop=True, labelbottom=False)
-    plt.setp(ax.get_xticklabels(), rotation=30, ha="left")
     fig.colorbar(im, ax=ax, label="SR [%]", shrink=min(1.0, 8 / max(len(tasks), 1)) if len(tasks) > 8 else 1.0)
     ax.set_title("Success rate per task", fontsize=10, pad=60)
     return _save(fig, path)
@@ -89,7 +88,7 @@ def plot_task_heatmap(records: Sequence[EpisodeRecord], path: Path) -> Path:
 def plot_distributions(records: Sequence[EpisodeRecord], path: Path) -> Path:
     """High-level steps and LLM tokens (prompt + completion) per episode, as box plots with the episodes as dots."""
     groups = group_by(records, system_label)
-    names = list(by_system(records))
+    names = list(groups)
     series = {
         "high-level steps per episode": [[r.high_level_steps for r in groups[n]] for n in names],
         "LLM tokens per episode": [[r.llm_usage.prompt_tokens + r.llm_usage.completion_tokens for r in groups[n]] for n in names],
@@ -123,7 +122,7 @@ def failure_reason(record: EpisodeRecord) -> str | None:
 def plot_failures(records: Sequence[EpisodeRecord], path: Path) -> Path:
     """Stacked bars: per system, its unsuccessful episodes split by failure reason."""
     groups = group_by(records, system_label)
-    names = list(by_system(records))
+    names = list(groups)
     counts = {n: Counter(c for r in groups[n] if (c := failure_reason(r)) is not None) for n in names}
     reasons = sorted({c for cnt in counts.values() for c in cnt}, key=lambda c: -sum(cnt[c] for cnt in counts.values()))
     fig, ax = plt.subplots(figsize=(9, 1.2 + 0.5 * len(names) + 0.25 * len(reasons)))

@@ -219,7 +219,6 @@ def viewer_data(episode_dir: Path) -> dict[str, Any]:
         "trajectory": [[round(x, 2), round(y, 2)] for x, y in record.trajectory],
         "steps": steps,
         "has_frames": folder.frames_dir.is_dir(),
-        "has_graphs": folder.graphs_dir.is_dir(),
     }
 
 

@@ -76,9 +76,9 @@ def with_pictures(messages: list[ChatMessage], pictures: Sequence[Picture]) -> l
     return [*messages[:-1], ChatMessage(role=last["role"], content=parts)]
 
 
-def object_list(descriptions: Sequence[str], *, numbered: bool = False) -> str:
-    """Objects one per line (``3: fridge A [open]`` when numbered), or 'none'."""
-    lines = [f"{i}: {d}" if numbered else d for i, d in enumerate(descriptions, start=1)]
+def object_list(descriptions: Sequence[str]) -> str:
+    """Objects one per line, numbered as their marks (``3: fridge A [open]``), or 'none'."""
+    lines = [f"{i}: {d}" for i, d in enumerate(descriptions, start=1)]
     return "\n".join(lines) or "none"
 
 
@@ -92,7 +92,7 @@ def step_messages(
 ) -> list[ChatMessage]:
     """The step decision: task, annotated current view and its marked objects, memories, skills."""
     messages = render_prompt(
-        "bumble_plan", task=task, skills=skill_api_text(SKILLS, vlm=True), objects=object_list(objects, numbered=True),
+        "bumble_plan", task=task, skills=skill_api_text(SKILLS, vlm=True), objects=object_list(objects),
         held_object=held or "nothing", history=history_text(history), feedback=feedback or "none",
     )
     return with_pictures(messages, [view])
@@ -106,7 +106,7 @@ def frames_messages(prompt: str, *, task: str, subtask: str, pictures: Sequence[
 
 def object_messages(*, task: str, subtask: str, view: Picture, objects: Sequence[str]) -> list[ChatMessage]:
     """The object step: the annotated frame and its marked objects."""
-    messages = render_prompt("bumble_object", task=task, subtask=subtask, objects=object_list(objects, numbered=True))
+    messages = render_prompt("bumble_object", task=task, subtask=subtask, objects=object_list(objects))
     return with_pictures(messages, [view])
 
 

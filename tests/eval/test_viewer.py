@@ -63,9 +63,10 @@ def test_page_cannot_be_broken_out_of(llm_episode: Episode) -> None:
     assert embedded is not None
     answers = [x["answer"] for s in json.loads(embedded.group(1))["steps"] for x in s["exchanges"]]
     assert EVIL in answers  # the data survives the escaping intact
-    assert json.loads(safe_json({"a": "</script>&<!--"})) == {"a": "</script>&<!--"}
-    title = render_viewer({**viewer_data(llm_episode.dir), "record": {
-        **viewer_data(llm_episode.dir)["record"], "task": "<i>t</i>"}})
+    text = safe_json({"a": "</script>&<!--"})
+    assert "<" not in text and "&" not in text and json.loads(text) == {"a": "</script>&<!--"}
+    data = viewer_data(llm_episode.dir)
+    title = render_viewer({**data, "record": {**data["record"], "task": "<i>t</i>"}})
     assert "<title><i>" not in title and "&lt;i&gt;t&lt;/i&gt;" in title
 
 
