@@ -7,8 +7,10 @@ scene graph and subpolicies; the oracle reads the world. Both run through the ev
 
 Prints one JSON line per (task set, planner): n, SR and TP in percent, failures per cause
 (docs/evaluation.md), reach failures on observed targets ("no path on the map", "the way is
-blocked", ...) per 100 high-level steps, and the planner's median plan time per step in ms; then
-one line per task set with the SR and TP gaps. It reads the worlds only through the harness, so it
+blocked", ...) per 100 high-level steps, the planner's median plan time per step in ms, and SR on
+the episodes whose description singles out every goal instance (``WorldStats.ambiguous_scopes``
+empty: no reader can beat chance on the others, docs/tasks.md); then one line per task set with
+the SR and TP gaps, overall and on those episodes. It reads the worlds only through the harness, so it
 runs unchanged on other worlds. Run:
 ``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--workers 2] [--limit N]
 [--start random|random-area|task-room] [--no-distractors]`` (run folders ``<out>/<start>[-no-distractors]/<task set>/<planner>``).
@@ -34,15 +36,21 @@ from more_agent.sim.tasks import task_set
 PLANNERS = ("grounded", "oracle")
 
 
+def unambiguous(records: list[EpisodeRecord]) -> list[EpisodeRecord]:
+    """The episodes whose description singles out every instance the goal names."""
+    return [r for r in records if r.world_stats is not None and not r.world_stats.ambiguous_scopes]
+
+
 def row(task_set_name: str, planner: str, records: list[EpisodeRecord]) -> dict[str, object]:
     """The JSON line of one (task set, planner)."""
-    s = summarize(records)
+    s, clear = summarize(records), unambiguous(records)
     steps = sum(r.high_level_steps for r in records)
     reach = sum(is_reach_failure(a) for r in records for a in r.actions)
     plan_ms = [1000 * r.timings.get("plan", 0.0) / r.high_level_steps for r in records if r.high_level_steps]
     return {
         "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
         "sr": round(100 * s.SR.mean, 1), "tp": round(100 * s.TP.mean, 1),
+        "n_unambiguous": len(clear), "sr_unambiguous": round(100 * summarize(clear).SR.mean, 1) if clear else None,
         "successes_per_seed": {seed: sum(r.success for r in records if r.seed == seed)
                                for seed in sorted({r.seed for r in records})},
         "high_level_steps": steps,
@@ -82,9 +90,11 @@ def main() -> None:
             print(json.dumps(row(name, planner, records)), flush=True)
         if set(PLANNERS) <= set(results):
             g, o = summarize(results["grounded"]), summarize(results["oracle"])
+            gc, oc = summarize(unambiguous(results["grounded"])), summarize(unambiguous(results["oracle"]))
             print(json.dumps({
                 "task_set": name, "sr_gap": round(100 * (o.SR.mean - g.SR.mean), 1),
                 "tp_gap": round(100 * (o.TP.mean - g.TP.mean), 1),
+                "sr_gap_unambiguous": round(100 * (oc.SR.mean - gc.SR.mean), 1),
             }), flush=True)
 
 

@@ -4,11 +4,13 @@
 
 Each world is instantiated as an episode would be (scene drawn with the seed, the scene's own
 objects, the start pose) and described by the episode record's ``WorldStats``: objects (furniture,
-doors and items), task objects, distractors, start room, task rooms and ``start_to_task_m`` (path
-on the true map, doors open, to the nearest pose from which a task object is within reach). The
-summary gives objects and distractors per world (median, max, and per scene type), the share of
-worlds whose robot starts outside every task room, the ``start_to_task_m`` distribution, the scenes
-used per task and the instantiation time. No planner runs.
+doors and items), task objects, distractors, start room, task rooms, ``start_to_task_m`` (path
+on the true map, doors open, to the nearest pose from which a task object is within reach) and the
+goal's furniture the description cannot single out (``ambiguous_scopes``). The summary gives objects
+and distractors per world (median, max, and per scene type), the share of worlds whose robot starts
+outside every task room (overall and per scene type), the worlds with an ambiguous goal instance,
+the ``start_to_task_m`` distribution, the scenes used per task and the instantiation time. No
+planner runs.
 """
 
 from __future__ import annotations
@@ -81,10 +83,13 @@ def main() -> None:
         "per_scene_type": {
             t: {"worlds": len(rs), "objects_median": statistics.median(r["objects"] for r in rs),
                 "objects_min": min(r["objects"] for r in rs), "objects_max": max(r["objects"] for r in rs),
-                "distractors_median": statistics.median(r["distractors"] for r in rs)}
+                "distractors_median": statistics.median(r["distractors"] for r in rs),
+                "start_outside_task_rooms": round(sum(r["outside_task_rooms"] for r in rs) / len(rs), 3),
+                "ambiguous_goal_worlds": sum(bool(r["ambiguous_scopes"]) for r in rs)}
             for t, rs in sorted(by_type.items())
         },
         "start_outside_task_rooms": round(sum(r["outside_task_rooms"] for r in rows) / max(len(rows), 1), 3),
+        "ambiguous_goal_worlds": sum(bool(r["ambiguous_scopes"]) for r in rows),
         "start_to_task_m": _quantiles(distances),
         "unreachable_starts": len(rows) - len(distances),
         "scenes_used": len({r["scene"] for r in rows}),

@@ -79,6 +79,10 @@ class WorldStats(FrozenModel):
     start_to_task_m: float | None = Field(
         default=None, description="Path length on the true map from the start pose to the nearest task object."
     )
+    ambiguous_scopes: list[str] = Field(
+        default_factory=list,
+        description="Goal scopes of furniture the description does not single out among others of its kind (sim.ambiguity).",
+    )
 
 
 class Failure(FrozenModel):

@@ -157,7 +157,10 @@ def run_episode(
 
 
 def world_stats(instance: TaskInstance) -> WorldStats:
-    """The world's size, clutter and start-to-task distance at the start of the episode."""
+    """The world's size, clutter, start-to-task distance and the goal instances its description cannot
+    single out, at the start of the episode."""
+    from more_agent.sim.ambiguity import ambiguous_scopes
+
     world, facts = instance.world, instance.start
     task_objects = {n for s, n in instance.scope.items() if n in world.objects and s not in instance.virtual_scopes}
     return WorldStats(
@@ -167,6 +170,7 @@ def world_stats(instance: TaskInstance) -> WorldStats:
         start_room=facts.start_room if facts else "",
         task_rooms=list(facts.task_rooms) if facts else [],
         start_to_task_m=facts.start_to_task_m if facts else None,
+        ambiguous_scopes=ambiguous_scopes(instance),
     )
 
 

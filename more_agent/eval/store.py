@@ -20,7 +20,6 @@ from pydantic import BaseModel, Field, ValidationError
 from more_agent.errors import UserError, check_writable_dir
 from more_agent.eval.runlock import LOCK_FILE
 from more_agent.records import EpisodeRecord, EpisodeSpec
-from more_agent.redaction import redact as redact_text
 
 EPISODES_FILE = "episodes.jsonl"
 RETRIED_FILE = "retried.jsonl"
@@ -43,11 +42,6 @@ class RunConfig(BaseModel):
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
     more_agent_version: str = Field(default="", description="Package version that wrote the run.")
-
-
-def redact(spec: str | None) -> str | None:
-    """An LLM spec with any credential replaced by ``***`` (:func:`more_agent.redaction.redact`)."""
-    return None if spec is None else redact_text(spec)
 
 
 MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "episode_fn")

@@ -199,14 +199,15 @@ class ChatClient:
         purpose: str,
         latency_s: float,
     ) -> Completion:
-        """The Completion for an answer (clipped): JSON extracted if asked for, cost from the price table."""
+        """The Completion for an answer (clipped when it was generated, so cached ones are too): JSON
+        extracted if asked for and not clipped, cost from the price table."""
         if self.backend.free:
             cost, known = 0.0, True
         else:
             price = price_of(answer.model, self.prices) or price_of(self.backend.model, self.prices)
             known = price is not None
             cost = 0.0 if cached or price is None else cost_usd(price, answer.prompt_tokens, answer.completion_tokens)
-        text = clip(answer.text, MAX_ANSWER_CHARS)
+        text = answer.text
         return Completion(
             text=text,
             parsed=extract_json(text) if request.schema is not None and len(text) <= MAX_ANSWER_CHARS else None,

@@ -41,16 +41,15 @@ from typing import Any, TypeVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from more_agent.llm import FilterAnswer, InvalidAnswer, LLMClient, ask_validated, parse_filter_answer
+from more_agent.llm import InvalidAnswer, LLMClient, ask_validated
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
-from more_agent.llm.prompts import filter_messages
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
-from more_agent.planners.llm_planner import INVALID, make_clients
+from more_agent.planners.llm_planner import INVALID, filter_view, make_clients
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
@@ -346,16 +345,8 @@ class BumblePlanner:
         objects = tuple(o for r in view.rooms for o in r.objects)
         flat = SceneView(rooms=(RoomText(OBSERVED_ROOM, "", objects, False),), robot_room=OBSERVED_ROOM,
                          held=view.held, held_id=view.held_id)
-        every = {i for o in objects for i in o.ids}
-        if not objects:
-            return every
-        try:
-            kept = self._ask(filter_messages(self.task, flat.text()), FilterAnswer,
-                             lambda a: parse_filter_answer(a, flat.names()), "filter")
-        except InvalidAnswer as e:
-            log.info("filter answer unusable, showing every object: %s", e.reason)
-            return every
-        return {i for r in flat.filtered(kept).rooms for o in r.objects for i in o.ids}
+        kept = filter_view(self.client, self.task, flat, max_reasks=self.config.max_reasks)
+        return {i for r in kept.rooms for o in r.objects for i in o.ids}
 
     def _ask(
         self,

@@ -22,6 +22,7 @@ is what the episode folder's ``steps.jsonl`` and ``graphs/`` hold.
 from __future__ import annotations
 
 import logging
+from collections.abc import Collection
 from dataclasses import dataclass
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -57,7 +58,7 @@ from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.skills import SKILLS
+from more_agent.skills import SKILLS, SKILLS_BY_NAME
 
 log = logging.getLogger(__name__)
 
@@ -236,32 +237,18 @@ class LLMPlanner:
 
     def _filter(self, view: SceneView) -> SceneView:
         """The task-relevant subgraph (paper Sec. III-B); the full view when nothing to filter or no usable answer."""
-        if not any(r.objects for r in view.rooms):
-            return view
-        try:
-            answer = ask_validated(
-                self.clients.plan, filter_messages(self.task, view.text()), FilterAnswer,
-                lambda a: parse_filter_answer(a, view.names()),
-                max_reasks=self.config.max_reasks, purpose="filter",
-            )
-        except InvalidAnswer as e:
-            log.info("filter answer unusable, planning on the full scene: %s", e.reason)
-            return view
-        if answer.value.unknown_rooms or answer.value.unknown_objects:
-            log.warning("filter answer named unknown rooms %s / objects %s: ignored",
-                        clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
-                        clip(str(answer.value.unknown_objects), MAX_NAME_CHARS))
-        return view.filtered(answer.value, always={view.robot_room})
+        return filter_view(self.clients.plan, self.task, view, max_reasks=self.config.max_reasks, always={view.robot_room})
 
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
             return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
         body, graph, view = self._body(), self._graph(), self._view()
-        if not action.arguments:  # done
+        params = SKILLS_BY_NAME[action.name].params
+        if not params:  # done
             return run_skill(body, graph, action.name, None)
         room = action.arguments[0]
-        if len(action.arguments) == 1 or (action.arguments[1] == FLOOR and not view.resolve(room, FLOOR)):
+        if "object" not in params or (action.arguments[1] == FLOOR and not view.resolve(room, FLOOR)):
             return run_skill(body, graph, action.name, Area(room, view.room(room).region_id))
         target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
         if target is None:
@@ -299,3 +286,25 @@ def make_moma_llm(llm: str | None) -> LLMPlanner:
 def make_moma_llm_sr(llm: str | None) -> LLMPlanner:
     """Registry factory of ``moma-llm-sr``."""
     return LLMPlanner(PLANNER_CONFIGS["moma-llm-sr"], make_clients(llm))
+
+
+def filter_view(
+    client: LLMClient, task: str, view: SceneView, *, max_reasks: int, always: Collection[str] = ()
+) -> SceneView:
+    """Ask MORE's filter (paper Sec. III-B) on ``view``; the rooms and objects it keeps (and the rooms
+    in ``always``), or the whole view when it has no objects or no usable answer came back."""
+    if not any(r.objects for r in view.rooms):
+        return view
+    try:
+        answer = ask_validated(
+            client, filter_messages(task, view.text()), FilterAnswer,
+            lambda a: parse_filter_answer(a, view.names()), max_reasks=max_reasks, purpose="filter",
+        )
+    except InvalidAnswer as e:
+        log.info("filter answer unusable, keeping the full scene: %s", e.reason)
+        return view
+    if answer.value.unknown_rooms or answer.value.unknown_objects:
+        log.warning("filter answer named unknown rooms %s / objects %s: ignored",
+                    clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
+                    clip(str(answer.value.unknown_objects), MAX_NAME_CHARS))
+    return view.filtered(answer.value, always=always)

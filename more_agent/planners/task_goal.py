@@ -12,16 +12,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from more_agent.sim import catalog
+from more_agent.sim.ambiguity import described_scopes, scope_categories
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.instantiate import TaskInstance
 from more_agent.sim.tasks import scope_synset
 
 _FLOOR = re.compile(r"^the (.+) floor$")
-_SCOPE_WORD = re.compile(r"\$([\w.]+?\.n\.\d+_\d+)")
-_INSTANCE_LABEL = re.compile(r"\S+ [A-Z]+")
-"""An instance label ('apple A'); a bare category ('every mail') names no instance."""
 
 FLOOR_SYNSETS = frozenset({"floor.n.01", "lawn.n.01", "driveway.n.01", "carpet.n.01"})
 """Synsets of room grounds: their scopes are floors, placed on where the robot stands."""
@@ -59,7 +56,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
               for lit in goals.ground_literals(i))
         for i in range(goals.n_options)
     )
-    described = _described_scopes(instance)
+    described = described_scopes(instance)
     robot = next((s for s, w in instance.scope.items() if w == ROBOT_NAME), ROBOT_NAME)
     categories: dict[str, frozenset[str]] = {}
     named: dict[str, str] = {}
@@ -72,18 +69,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
             match = _FLOOR.match(instance.label(scope)) if scope in described else None
             floors[scope] = match.group(1).replace(" ", "_") if match else None
             continue
-        categories[scope] = frozenset(catalog.synset_categories(synset)) | {synset.split(".")[0]}
+        categories[scope] = scope_categories(scope)
         if scope in described:
             named[scope] = instance.label(scope)
     return TaskGoal(options=options, categories=categories, named=named, floor_rooms=floors, robot=robot)
-
-
-def _described_scopes(instance: TaskInstance) -> set[str]:
-    """Scopes whose instance the description names: the paper's ``$scope`` words, or the scopes whose
-    instance label a description generated from the goal contains (a quantified scope is named by its
-    category only: 'every mail' binds no instance)."""
-    text = instance.definition.paper_description
-    if text is not None:
-        return set(_SCOPE_WORD.findall(text)) & set(instance.scope)
-    return {s for s in instance.scope
-            if _INSTANCE_LABEL.fullmatch(label := instance.label(s)) and re.search(rf"\b{re.escape(label)}\b", instance.description)}

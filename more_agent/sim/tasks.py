@@ -67,7 +67,7 @@ class TaskDefinition:
     @property
     def n_goal_literals(self) -> int:
         """Number of atomic literals written in the goal (before quantifier expansion)."""
-        return sum(1 for _ in _atoms(self.goal))
+        return sum(1 for _ in atoms(self.goal))
 
     def room_requirements(self) -> dict[str, Counter[str]]:
         """Room type -> synset counts that the task's ``inroom`` literals require."""
@@ -83,7 +83,7 @@ def scope_synset(scope: str) -> str:
     return scope.lstrip("?").rsplit("_", 1)[0]
 
 
-def _atoms(node: Any) -> Iterator[ParsedLiteral]:
+def atoms(node: Any) -> Iterator[ParsedLiteral]:
     """The atomic literals (a predicate over terms) anywhere in a parse tree, in order.
 
     Quantifier variable declarations (``['?x', '-', 'plate.n.04']``) and counts (``['2']``) are not atoms.
@@ -96,12 +96,12 @@ def _atoms(node: Any) -> Iterator[ParsedLiteral]:
             yield node
         return
     for child in node:
-        yield from _atoms(child)
+        yield from atoms(child)
 
 
 def atomic_predicates(parsed: list[ParsedLiteral]) -> set[str]:
     """Names of the atomic predicates used anywhere in a parse tree."""
-    return {atom[0] for atom in _atoms(parsed)}
+    return {atom[0] for atom in atoms(parsed)}
 
 
 # -- catalogue ------------------------------------------------------------------------------------

@@ -275,13 +275,7 @@ class World:
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
         obj, support = self.objects[name], self.objects[parent]
-        obj.parent, obj.relation = parent, relation
-        obj.room = support.room
-        self._move_subtree(obj, self._free_slot(obj, support, relation))
-        if self.robot.held == name:
-            self.robot.held = None
-        self.version += 1
-        self.layout_version += 1
+        self._rest(obj, support, relation, self._free_slot(obj, support, relation))
 
     def place_if_room(self, name: str, parent: str, relation: Relation, *, stack: bool = False) -> bool:
         """Like ``place``, but only where a free slot exists (``free_slot``); False (nothing changed)
@@ -290,18 +284,20 @@ class World:
         slot = self.free_slot(obj, support, relation, stack=stack)
         if slot is None:
             return False
-        obj.parent, obj.relation, obj.room = parent, relation, support.room
-        self._move_subtree(obj, slot)
-        self.version += 1
-        self.layout_version += 1
+        self._rest(obj, support, relation, slot)
         return True
 
     def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
         """Rest item ``name`` on a room floor at a given position (no precondition checks)."""
         obj, support = self.objects[name], self.objects[floor]
-        obj.parent, obj.relation, obj.room = floor, "ontop", support.room
-        self._move_subtree(obj, np.array([xy[0], xy[1], support.top + obj.size[2] / 2]))
-        if self.robot.held == name:
+        self._rest(obj, support, "ontop", np.array([xy[0], xy[1], support.top + obj.size[2] / 2]))
+
+    def _rest(self, obj: WorldObject, support: WorldObject, relation: Relation, center: np.ndarray) -> None:
+        """Make ``obj`` rest in / on ``support`` centred at ``center`` (what rests on it moves along),
+        out of the gripper if it was held."""
+        obj.parent, obj.relation, obj.room = support.name, relation, support.room
+        self._move_subtree(obj, center)
+        if self.robot.held == obj.name:
             self.robot.held = None
         self.version += 1
         self.layout_version += 1

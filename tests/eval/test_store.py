@@ -20,7 +20,6 @@ from more_agent.eval.store import (
     prepare_run_dir,
     read_records,
     read_run_config,
-    redact,
     retire_retryable,
 )
 from more_agent.records import EpisodeRecord, EpisodeSpec
@@ -133,9 +132,7 @@ def test_pending_matches_unset_scene_to_any_scene() -> None:
     assert pending(pinned, done) == pinned
 
 
-def test_redact_and_dirname() -> None:
-    assert redact("openai:gpt-4o?api_key=sk-123&base=x") == "openai:gpt-4o?api_key=***&base=x"
-    assert redact(None) is None
+def test_dirname() -> None:
     assert episode_dirname("a/b", None, 3, "more") == "a_b__auto__s3__more"
 
 
