@@ -137,6 +137,13 @@ def is_openable(category: str) -> bool:
     return any(tax.has_ability(s, "openable") for s in category_synsets(category))
 
 
+@cache
+def is_cloth(category: str) -> bool:
+    """True if the category's synset has the 'cloth' ability (garments, towels, sheets: they fold and crumple)."""
+    tax = taxonomy()
+    return any(tax.has_ability(s, "cloth") for s in category_synsets(category))
+
+
 # --- Which listed objects become scene furniture (our decision, documented in docs/scenes.md) ---
 
 SKIPPED_CATEGORIES: frozenset[str] = frozenset(

@@ -156,14 +156,15 @@ def add_distractors(world: World, rng: np.random.Generator, counts: dict[str, di
         placer = _RoomPlacer(world, room, rng)
         for category in sorted(per_category):
             synsets = catalog.category_synsets(category)
-            synset, size, openable = synsets[0] if synsets else None, catalog.category_size(category), catalog.is_openable(category)
+            synset, size = synsets[0] if synsets else None, catalog.category_size(category)
+            openable, cloth = catalog.is_openable(category), catalog.is_cloth(category)
             for _ in range(per_category[category]):
                 while f"{category}_o{serial}" in world.objects:
                     serial += 1
                 name = f"{category}_o{serial}"
                 world.add(WorldObject(
                     name=name, category=category, kind="item", room=room, synset=synset,
-                    center=np.zeros(3), size=np.array(size, dtype=float), openable=openable,
+                    center=np.zeros(3), size=np.array(size, dtype=float), openable=openable, cloth=cloth,
                 ))
                 if placer.place(name):
                     clutter.items.append(name)

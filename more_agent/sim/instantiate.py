@@ -310,7 +310,7 @@ class _Builder:
             self.world.add(WorldObject(
                 name=name, category=category, kind="item", synset=synset,
                 center=np.zeros(3), size=np.array(catalog.category_size(category), dtype=float),
-                openable=catalog.is_openable(category),
+                openable=catalog.is_openable(category), cloth=catalog.is_cloth(category),
             ))
             self.scope[s] = name
             self.items.append(s)

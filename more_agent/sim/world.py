@@ -45,6 +45,12 @@ LEVELLED_CATEGORIES = frozenset(
 LEVEL_STEP_M = 0.4
 """Spacing of the inner levels of a ``LEVELLED_CATEGORIES`` support, from its bottom slab up."""
 
+MAX_FOLDS = 3
+"""Times a cloth item is folded in half, at most, to fit where it is put (``World.fit``)."""
+
+CLOTH_LAYER_M = 0.01
+"""Thickness of one layer of cloth: a garment folded n times lies 2^n layers thick (``World.fit``)."""
+
 
 def floor_name(room_id: str) -> str:
     """Name of the floor object of a room (every room has one)."""
@@ -65,6 +71,8 @@ class WorldObject:
     label: str = ""
     openable: bool = False
     is_open: bool = False
+    cloth: bool = False
+    """Folds to fit where it rests (``World.fit``), as BEHAVIOR-1K's deformable garments crumple."""
     parent: str | None = None
     relation: Relation | None = None
     instance_id: int = 0
@@ -275,27 +283,26 @@ class World:
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
         obj, support = self.objects[name], self.objects[parent]
-        self._rest(obj, support, relation, self._free_slot(obj, support, relation))
+        self._rest(obj, support, relation, *self._magic_fit(obj, support, relation))
 
     def place_if_room(self, name: str, parent: str, relation: Relation, *, stack: bool = False) -> bool:
-        """Like ``place``, but only where a free slot exists (``free_slot``); False (nothing changed)
-        when there is none."""
+        """Like ``place``, but only where it fits (``fit``); False (nothing changed) when it does not."""
         obj, support = self.objects[name], self.objects[parent]
-        slot = self.free_slot(obj, support, relation, stack=stack)
-        if slot is None:
+        fitted = self.fit(obj, support, relation, stack=stack)
+        if fitted is None:
             return False
-        self._rest(obj, support, relation, slot)
+        self._rest(obj, support, relation, *fitted)
         return True
 
     def place_on_floor_at(self, name: str, floor: str, xy: tuple[float, float]) -> None:
         """Rest item ``name`` on a room floor at a given position (no precondition checks)."""
         obj, support = self.objects[name], self.objects[floor]
-        self._rest(obj, support, "ontop", np.array([xy[0], xy[1], support.top + obj.size[2] / 2]))
+        self._rest(obj, support, "ontop", np.array([xy[0], xy[1], support.top + obj.size[2] / 2]), obj.size)
 
-    def _rest(self, obj: WorldObject, support: WorldObject, relation: Relation, center: np.ndarray) -> None:
-        """Make ``obj`` rest in / on ``support`` centred at ``center`` (what rests on it moves along),
-        out of the gripper if it was held."""
-        obj.parent, obj.relation, obj.room = support.name, relation, support.room
+    def _rest(self, obj: WorldObject, support: WorldObject, relation: Relation, center: np.ndarray, size: np.ndarray) -> None:
+        """Make ``obj`` rest in / on ``support`` centred at ``center`` with box ``size`` (folded cloth; what
+        rests on it moves along), out of the gripper if it was held."""
+        obj.parent, obj.relation, obj.room, obj.size = support.name, relation, support.room, size
         self._move_subtree(obj, center)
         if self.robot.held == obj.name:
             self.robot.held = None
@@ -344,28 +351,49 @@ class World:
         margin = np.minimum(0.05, support.size[:2] * 0.1)
         return lo[:2] + margin, hi[:2] - margin, support.bottom + slab
 
-    def _free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation) -> np.ndarray:
-        """Centre of the first free slot on the support, stacking when it is full (``free_slot``), else
-        the support's centre: magic placement, like the paper's, never fails for lack of room."""
-        slot = self.free_slot(obj, support, relation, stack=True)
-        if slot is not None:
-            return slot
+    def _magic_fit(self, obj: WorldObject, support: WorldObject, relation: Relation) -> tuple[np.ndarray, np.ndarray]:
+        """Centre and size where ``obj`` fits, stacking when the surface is full (``fit``), else the
+        support's centre: magic placement, like the paper's, never fails for lack of room."""
+        fitted = self.fit(obj, support, relation, stack=True)
+        if fitted is not None:
+            return fitted
         lo, hi, z = self.support_surface(support, relation)
         cx, cy = (lo + hi) / 2
-        return np.array([cx, cy, z + obj.size[2] / 2])
+        return np.array([cx, cy, z + obj.size[2] / 2]), obj.size
 
-    def free_slot(self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False) -> np.ndarray | None:
-        """Centre of the first slot on the support, in reading order, where the item's box meets no other
-        box (``_obstacles``); with ``stack``, when the surface is full, on the next layer up (on the
-        items already there; in a closed-lid container only while it fits under the lid). An item
-        wider than the surface overhangs it, centred. None when there is no such slot."""
+    def fit(self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
+        """(centre, size) of ``obj`` at its first free slot (``free_slot``) in its own shape or, for
+        cloth, folded in half up to ``MAX_FOLDS`` times, as a garment goes into a washer or a carton;
+        None when no shape fits. A fold halves the longer side and lays the garment flat, 2^folds
+        layers of cloth thick at most (a garment model's box is a draped heap, mostly air)."""
+        lo, hi, _ = self.support_surface(support, relation)
+        size, folds = obj.size, MAX_FOLDS if obj.cloth else 0
+        for fold in range(folds + 1):
+            if fold:
+                size = size * np.where(np.arange(3) == np.argmax(size[:2]), 0.5, 1.0)
+                size[2] = min(size[2], CLOTH_LAYER_M * 2**fold)
+            if fold < folds and np.any(size[:2] + SLOT_GAP_M > hi - lo):
+                continue  # cloth folds rather than overhang
+            slot = self.free_slot(obj, support, relation, stack=stack, size=size)
+            if slot is not None:
+                return slot, size
+        return None
+
+    def free_slot(
+        self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False, size: np.ndarray | None = None,
+    ) -> np.ndarray | None:
+        """Centre of the first slot on the support, in reading order, where the item's box (of ``size``,
+        default its own) meets no other box (``_obstacles``); with ``stack``, when the surface is full,
+        on the next layer up (on the items already there; in a closed-lid container only while it fits
+        under the lid). An item wider than the surface overhangs it, centred. None when there is no such slot."""
+        size = obj.size if size is None else size
         lo, hi, z = self.support_surface(support, relation)
-        half = obj.size[:2] / 2 + SLOT_GAP_M / 2
+        half = size[:2] / 2 + SLOT_GAP_M / 2
         xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
         gx, gy = np.meshgrid(xs, ys)  # rows follow y: reading order is row by row
         slots = np.stack([gx.ravel(), gy.ravel()], axis=1)
         while True:
-            others = self._obstacles(obj, support, lo, hi, z)
+            others = self._obstacles(obj, support, lo, hi, z, size[2])
             free = slots
             if others:
                 centers = np.array([o.center[:2] for o in others])
@@ -373,18 +401,20 @@ class World:
                 overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
                 free = slots[~overlap]
             if len(free):
-                return np.array([free[0, 0], free[0, 1], z + obj.size[2] / 2])
+                return np.array([free[0, 0], free[0, 1], z + size[2] / 2])
             layer = [o.top for o in others if o.parent == support.name and o.relation == relation]
             lidded = relation == "inside" and support.openable
-            if not stack or not layer or (lidded and max(layer) + obj.size[2] > support.top):
+            if not stack or not layer or (lidded and max(layer) + size[2] > support.top):
                 return None
             z = max(layer)
 
-    def _obstacles(self, obj: WorldObject, support: WorldObject, lo: np.ndarray, hi: np.ndarray, z: float) -> list[WorldObject]:
-        """Objects in the space an item of ``obj``'s height would take on the surface (``lo``, ``hi``, ``z``):
+    def _obstacles(
+        self, obj: WorldObject, support: WorldObject, lo: np.ndarray, hi: np.ndarray, z: float, height: float,
+    ) -> list[WorldObject]:
+        """Objects in the space an item of ``height`` would take on the surface (``lo``, ``hi``, ``z``):
         items already there and anything else standing in it (a TV on the coffee table, a shelf
         hung above a desk), but not the supports of ``support`` nor ``obj``, its load or the held item."""
-        lo3, hi3 = np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + obj.size[2]])
+        lo3, hi3 = np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + height])
         skip = {obj.name, support.name, self.robot.held} | {o.name for o in self.descendants(obj.name)}
         skip |= {parent.name for parent, _ in self.ancestors(support.name)}
         objs = [o for o in self.objects.values() if o.kind != "floor" and o.name not in skip]

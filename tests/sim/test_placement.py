@@ -99,3 +99,20 @@ def test_a_single_board_hung_high_keeps_items_on_its_top() -> None:
     _add(world, "jar_0", "jar", "item", (5.0, 5.0, 0.0), (0.1, 0.1, 0.1))
     world.place("jar_0", board.name, "ontop")
     assert world.objects["jar_0"].bottom == board.top and enclosing_object(world, "jar_0") is None
+
+
+def test_a_garment_folds_into_a_washer_where_a_rigid_box_of_its_size_does_not() -> None:
+    world = _world()
+    washer = _add(world, "washer_0", "washer", "furniture", (0.0, 0.0, 0.42), (0.58, 0.6, 0.85), openable=True)
+    size = (0.77, 0.46, 0.31)  # the median jersey model: a draped heap wider than the drum
+    for k in range(4):
+        _add(world, f"jersey_{k}", "jersey", "item", (5.0, 5.0, 0.0), size, cloth=True)
+        assert world.place_if_room(f"jersey_{k}", washer.name, "inside", stack=True)
+        jersey = world.objects[f"jersey_{k}"]
+        lo, hi, _ = world.support_surface(washer, "inside")
+        assert np.all(jersey.box()[0][:2] >= lo - 1e-9) and np.all(jersey.box()[1][:2] <= hi + 1e-9)  # no overhang
+        assert jersey.top <= washer.top and enclosing_object(world, f"jersey_{k}") is None
+        assert jersey.size[0] * jersey.size[1] < size[0] * size[1]  # folded
+    _add(world, "crate_0", "crate", "item", (5.0, 5.0, 0.0), size)
+    world.place_if_room("crate_0", washer.name, "inside", stack=True)
+    assert np.array_equal(world.objects["crate_0"].size, size)  # a rigid item keeps its shape
