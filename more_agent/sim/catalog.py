@@ -137,6 +137,21 @@ def is_openable(category: str) -> bool:
     return any(tax.has_ability(s, "openable") for s in category_synsets(category))
 
 
+@cache
+def can_hold_things(category: str) -> bool:
+    """True if the category's synset has the 'fillable' ability (cabinets, fridge, car; not a laptop)."""
+    tax = taxonomy()
+    return any(tax.has_ability(s, "fillable") for s in category_synsets(category))
+
+
+@cache
+def is_scene_fixture(category: str) -> bool:
+    """True if BEHAVIOR-1K marks the category's synset a scene object (its 'sceneObject' ability: car,
+    fridge, shopping cart, bathtub): part of a scene, never picked up."""
+    tax = taxonomy()
+    return any(tax.has_ability(s, "sceneObject") for s in category_synsets(category))
+
+
 # --- Which listed objects become scene furniture (our decision, documented in docs/scenes.md) ---
 
 SKIPPED_CATEGORIES: frozenset[str] = frozenset(
