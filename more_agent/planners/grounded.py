@@ -27,7 +27,8 @@ Every step (MPC style) it rebuilds the scene graph and:
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
-picked up is dropped at once, and no instance of its category is bound to a scope the goal moves.
+picked up is dropped at once (a category can be both: a store's cartons are furniture, a task's are
+items).
 Regions are labelled with the room type their furniture fits best (:mod:`more_agent.planners.room_types`).
 """
 
@@ -118,8 +119,6 @@ class GroundedPlanner:
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
         self.dropped: set[str] = set()
-        self.fixtures: set[str] = set()
-        """Categories an instance of which could not be picked up: no scope the goal moves binds to one."""
         self.out_of_reach: dict[str, int] = {}
         """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
         self.failures: Counter[tuple[str, tuple[str, ...], str]] = Counter()
@@ -195,8 +194,6 @@ class GroundedPlanner:
             return self.bound.get(scope)
         taken = set(self.bound.values()) | set(self.goal.named.values()) | self.dropped
         cats = self.goal.categories.get(scope, frozenset())
-        if scope in self.goal.moved:
-            cats = cats - self.fixtures
         candidates = [o for o in self.seen.values() if o.category in cats and o.label not in taken]
         if not candidates:
             return None
@@ -473,8 +470,7 @@ class GroundedPlanner:
             limit = MAX_REACH_FAILURES
         else:
             key, limit = (action.name, action.arguments, result.feedback), MAX_FAILURES
-        if result.reason is FailureReason.NOT_GRASPABLE:  # a property of the kind: no other instance is tried
-            self.fixtures.add(self.seen[step.target].category)
+        if result.reason is FailureReason.NOT_GRASPABLE:  # furniture: trying again cannot help
             limit = 1
         self.failures[key] += 1
         if self.failures[key] < limit:

@@ -119,22 +119,21 @@ def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
     assert can_hold_things("car") and can_hold_things("bottom_cabinet") and not can_hold_things("laptop")
 
 
-def test_a_kind_that_cannot_be_picked_up_is_not_bound_again() -> None:
+def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
     from more_agent.planners.base import EpisodeContext
 
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # the grasp changes it
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     planner.observe()
     scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
     label = planner.bound[scope]
     planner._step = _Step(HighLevelAction("go_to_and_grasp", ("kitchen_0", label)), target=label)
-    planner.execute(planner._step.action)  # the real grasp: the item can be picked up
-    assert planner.bound[scope] == label and not planner.fixtures
+    hand = ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full")
+    planner._failed(planner._step.action, planner._step, hand)
+    assert planner.bound[scope] == label  # one failure of another kind: tried again
     refused = ActionResult(ok=False, reason=FailureReason.NOT_GRASPABLE, feedback=f"{label} cannot be picked up")
-    planner._failed(planner._step.action, planner._step, refused)  # as if it were fixed furniture
-    assert scope not in planner.bound and planner.seen[label].category in planner.fixtures
-    assert all(planner.seen[x].category not in planner.fixtures for x in filter(None, [planner._label(scope)]))
+    planner._failed(planner._step.action, planner._step, refused)  # as if it were furniture
+    assert scope not in planner.bound and label in planner.dropped and planner._label(scope) != label
 
 
 def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
