@@ -28,8 +28,8 @@ Every step (MPC style) it rebuilds the scene graph and:
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
 picked up is dropped at once (a category can be both: a store's cartons are furniture, a task's are
-items).
-Regions are labelled with the room type their furniture fits best (:mod:`more_agent.planners.room_types`).
+items). Regions are labelled with the room type their furniture fits best
+(:mod:`more_agent.planners.room_types`).
 """
 
 from __future__ import annotations
