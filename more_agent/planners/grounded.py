@@ -11,21 +11,25 @@ Every step (MPC style) it rebuilds the scene graph and:
 1. binds each goal scope to an observed instance: the label the description names, else the
    nearest unbound instance of a category that counts as the scope's synset; bindings stay;
 2. evaluates every literal of the goal option on what it believes (observed open state and spatial
-   relations, its own placements on floors) and calls ``done`` when all hold;
+   relations, its own placements on floors, objects whose box reaches the ground on their room's
+   floor) and calls ``done`` when all hold;
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place, put down what the hand holds but does
-   not need;
-4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
-   at most while there is a room to explore), explores the room most likely to hold the missing
-   furniture (BEHAVIOR-1K room inventories), a room whose explores still reveal new objects before
-   the others, then the one explored least often, the nearest; each explore drives to the frontiers
-   farthest from the robot's path. A room whose last two explores revealed nothing new yields to the
-   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
+   not need (on the floor, or on low furniture when the goal wants it off that floor);
+4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
+   hold things, not a laptop; three in a row at most while there is a room to explore), explores
+   the room most likely to hold the missing furniture (BEHAVIOR-1K room inventories), a room whose
+   explores still reveal new objects before the others, then the one explored least often, the
+   nearest; each explore drives to the frontiers farthest from the robot's path. A room whose last
+   two explores revealed nothing new yields to the other containers and closed doors; the planner
+   gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
-(another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
-with the room type their furniture fits best (:mod:`more_agent.planners.room_types`).
+(another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
+picked up is dropped at once (a category can be both: a store's cartons are furniture, a task's are
+items). Regions are labelled with the room type their furniture fits best
+(:mod:`more_agent.planners.room_types`).
 """
 
 from __future__ import annotations
@@ -39,7 +43,7 @@ import numpy as np
 
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.language import room_names
-from more_agent.planners.oracle import ORACLE_PREDICATES, order_literals
+from more_agent.planners.oracle import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type
@@ -47,6 +51,7 @@ from more_agent.planners.task_goal import TaskGoal, task_goal
 from more_agent.records import LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.goals import Literal
 from more_agent.sim.navgrid import XY
 
@@ -67,6 +72,9 @@ FAR_FRONTIER_SHARE = 0.5
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
+
+GROUND_M = 0.05
+"""An object whose observed box reaches this low, resting on no observed object, stands on the floor."""
 
 Relation = tuple[str, str]
 """(predicate 'inside' / 'ontop', label of the container / support, or 'floor <room>')."""
@@ -148,7 +156,7 @@ class GroundedPlanner:
             if obj.held:
                 self.relation[obj.label] = None
             elif obj.label in rel or not _on_floor(self.relation.get(obj.label)):
-                self.relation[obj.label] = rel.get(obj.label)
+                self.relation[obj.label] = rel.get(obj.label) or self._on_ground(obj)
         self.graph, self.names = graph, room_names(graph)
 
     def decide(self) -> HighLevelAction:
@@ -193,6 +201,14 @@ class GroundedPlanner:
         best = min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label))
         self.bound[scope] = best.label
         return best.label
+
+    def _on_ground(self, obj: ObjectNode) -> Relation | None:
+        """The floor of its room when the object's box reaches the ground (``GROUND_M``): the scene graph
+        relates objects to objects only, and without this an item lying on a lawn would be believed
+        off it."""
+        if obj.bbox.min[2] > GROUND_M:
+            return None
+        return "ontop", f"{FLOOR} {self.room_types.get(obj.region_id or '', '')}"
 
     def _floor_region(self, scope: str) -> str | None:
         """A reachable region whose room type is the floor's (any region when the description names none)."""
@@ -329,8 +345,8 @@ class GroundedPlanner:
         note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
         here = graph.robot.region_id
         closed = sorted(
-            (o for o in graph.objects.values()
-             if o.open is False and o.category != "door" and o.label not in self.looked_into and o.label not in self.dropped),
+            (o for o in graph.objects.values() if o.open is False and can_hold_things(o.category)
+             and o.label not in self.looked_into and o.label not in self.dropped),
             key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
         )
         region = self._room_to_explore(missing)
@@ -381,8 +397,33 @@ class GroundedPlanner:
                      frontiers=far_frontiers(self._graph().frontiers(region), self.body.trajectory))
 
     def _put_down(self, held: str) -> _Step:
-        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(self._graph().robot.region_id), FLOOR),
-                                     note=f"free the hand of {held}"))
+        """Free the hand: on the floor where the robot stands, unless the goal wants the item off that
+        floor; then on top of the nearest low furniture seen (the oracle's choice), if there is one."""
+        here = self._graph().robot.region_id
+        note = f"free the hand of {held}"
+        support = self._support_for(held) if self._off_floor(held, here) else None
+        if support is not None:
+            return self._object_step("go_to_and_place_ontop", support, note)
+        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(here), FLOOR), note=note))
+
+    def _off_floor(self, held: str, region: str | None) -> bool:
+        """Whether a goal literal wants ``held`` off the floor of ``region`` (``not ontop`` a floor scope
+        that names no room or names this room's type)."""
+        kind = self.room_types.get(region or "")
+        return any(lit.negated and lit.predicate == "ontop" and self.goal.is_floor(lit.args[1])
+                   and self.bound.get(lit.args[0]) == held and self.goal.floor_rooms[lit.args[1]] in (None, kind)
+                   for lit in self.literals)
+
+    def _support_for(self, held: str) -> str | None:
+        """The nearest reachable observed furniture to put ``held`` on top of: low enough to reach
+        (``PUT_DOWN_MAX_TOP_M``), not closed, not given up on; in the robot's room first."""
+        here = self._graph().robot.region_id
+        spots = [o for label in self._reachable() if label not in self.dropped and label != held
+                 and is_furniture((o := self.seen[label]).category) and o.category != "door"
+                 and o.bbox.max[2] <= PUT_DOWN_MAX_TOP_M and o.open is not False]
+        if not spots:
+            return None
+        return min(spots, key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label)).label
 
     def _floor_step(self, region: str, note: str) -> _Step:
         return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(region), FLOOR), note=note), region=region)
@@ -429,6 +470,8 @@ class GroundedPlanner:
             limit = MAX_REACH_FAILURES
         else:
             key, limit = (action.name, action.arguments, result.feedback), MAX_FAILURES
+        if result.reason is FailureReason.NOT_GRASPABLE:  # furniture: trying again cannot help
+            limit = 1
         self.failures[key] += 1
         if self.failures[key] < limit:
             return

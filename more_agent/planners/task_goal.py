@@ -2,9 +2,10 @@
 
 :func:`task_goal` turns a task instance into a :class:`TaskGoal`: bddl's ground goal options as
 literals over *scope* names (``apple.n.01_1``, never world object names), the object categories each
-scope may be, the instance labels the description names (``apple A``), and the room type of each
-floor scope the description names ("the kitchen floor"). Nothing here reads world state: scopes
-are matched to scene-graph objects by the planner, through what the robot observes.
+scope may be, the instance labels the description names (``apple A``), the room type of each floor
+scope the description names ("the kitchen floor") and which scopes the goal moves. Nothing here
+reads world state: scopes are matched to scene-graph objects by the planner, through what the robot
+observes.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.goals import GoalChecker, Literal
@@ -31,13 +33,16 @@ class TaskGoal:
     options: tuple[tuple[Literal, ...], ...]
     """bddl's ground options (each a conjunction that satisfies the goal), literals over scope names."""
     categories: dict[str, frozenset[str]]
-    """Scope -> object categories that count as it (the synset's own and its descendants')."""
+    """Scope -> object categories that count as it (the synset's own and its descendants'; for a scope the
+    goal moves, no descendant that is a scene fixture: a car is a container, but none to put in a car)."""
     named: dict[str, str]
     """Scope -> instance label the description names it by (``apple A``)."""
     floor_rooms: dict[str, str | None]
     """Floor scope -> the room type the description names ('kitchen'), None when it names none."""
     robot: str
     """The agent's scope name."""
+    moved: frozenset[str] = frozenset()
+    """Scopes the goal moves (subjects of placement literals): only things that can be picked up are them."""
 
     def is_floor(self, scope: str) -> bool:
         return scope in self.floor_rooms
@@ -61,6 +66,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
     categories: dict[str, frozenset[str]] = {}
     named: dict[str, str] = {}
     floors: dict[str, str | None] = {}
+    moved = {lit.args[0] for option in options for lit in option if len(lit.args) == 2 and lit.args[0] != robot}
     for scope in instance.scope:
         synset = scope_synset(scope)
         if scope == robot:
@@ -69,7 +75,11 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
             match = _FLOOR.match(instance.label(scope)) if scope in described else None
             floors[scope] = match.group(1).replace(" ", "_") if match else None
             continue
-        categories[scope] = scope_categories(scope)
+        own = synset.split(".")[0]
+        categories[scope] = frozenset(c for c in scope_categories(scope)
+                                      if scope not in moved or c == own or not catalog.is_scene_fixture(c))
         if scope in described:
             named[scope] = instance.label(scope)
-    return TaskGoal(options=options, categories=categories, named=named, floor_rooms=floors, robot=robot)
+    return TaskGoal(options=options, categories=categories, named=named, floor_rooms=floors, robot=robot,
+                    moved=frozenset(moved))
+

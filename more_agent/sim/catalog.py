@@ -131,17 +131,31 @@ def synset_categories(synset: str) -> list[str]:
 
 
 @cache
+def has_ability(category: str, ability: str) -> bool:
+    """True if one of the category's synsets has the BEHAVIOR-1K taxonomy ability (``openable``, ``cloth``, ...)."""
+    tax = taxonomy()
+    return any(tax.has_ability(s, ability) for s in category_synsets(category))
+
+
 def is_openable(category: str) -> bool:
-    """True if the category's synset has the 'openable' ability (fridge, cabinets, car, ...)."""
-    tax = taxonomy()
-    return any(tax.has_ability(s, "openable") for s in category_synsets(category))
+    """True if the category opens (fridge, cabinets, car, ...)."""
+    return has_ability(category, "openable")
 
 
-@cache
 def is_cloth(category: str) -> bool:
-    """True if the category's synset has the 'cloth' ability (garments, towels, sheets: they fold and crumple)."""
-    tax = taxonomy()
-    return any(tax.has_ability(s, "cloth") for s in category_synsets(category))
+    """True for cloth (garments, towels, sheets): it folds and crumples."""
+    return has_ability(category, "cloth")
+
+
+def can_hold_things(category: str) -> bool:
+    """True if things can be put inside (the 'fillable' ability: cabinets, fridge, car; not a laptop)."""
+    return has_ability(category, "fillable")
+
+
+def is_scene_fixture(category: str) -> bool:
+    """True if BEHAVIOR-1K marks it a scene object ('sceneObject': car, fridge, shopping cart, bathtub):
+    part of a scene, never picked up."""
+    return has_ability(category, "sceneObject")
 
 
 # --- Which listed objects become scene furniture (our decision, documented in docs/scenes.md) ---

@@ -7,13 +7,17 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import run_episode
-from more_agent.planners.base import default_planner, make_planner
-from more_agent.planners.grounded import FRUITLESS_EXPLORES, OPENS_BEFORE_EXPLORING, GroundedPlanner, far_frontiers
+from more_agent.planners.base import HighLevelAction, default_planner, make_planner
+from more_agent.planners.grounded import (
+    FLOOR, FRUITLESS_EXPLORES, GROUND_M, OPENS_BEFORE_EXPLORING, GroundedPlanner, _on_floor, _Step, far_frontiers,
+)
 from more_agent.planners.room_types import is_furniture, likely_room_type
 from more_agent.planners.task_goal import task_goal
 from more_agent.records import EpisodeSpec
-from more_agent.sim.goals import GoalChecker, GoalStatus
-from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.actions import ActionResult, FailureReason
+from more_agent.sim.catalog import can_hold_things
+from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
+from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
 
@@ -103,3 +107,50 @@ def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None
     assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
     planner.fruitless[step.region] = FRUITLESS_EXPLORES  # its last explores showed nothing new
     assert planner._search(lit, None).action.name == "go_to_and_open"
+
+
+def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
+    inst = instantiate("loading_the_car", None, 1, start="task-room", distractors=False)
+    goal = task_goal(inst, GoalChecker(inst))
+    assert "container.n.01_1" in goal.moved and "car.n.01_1" not in goal.moved  # a container goes into the car
+    container = goal.categories["container.n.01_1"]
+    assert "car" not in container and "shopping_cart" not in container and "bucket" in container
+    assert goal.categories["car.n.01_1"] == {"car"}
+    assert can_hold_things("car") and can_hold_things("bottom_cabinet") and not can_hold_things("laptop")
+
+
+def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
+    from more_agent.planners.base import EpisodeContext
+
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
+    label = planner.bound[scope]
+    planner._step = _Step(HighLevelAction("go_to_and_grasp", ("kitchen_0", label)), target=label)
+    hand = ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full")
+    planner._failed(planner._step.action, planner._step, hand)
+    assert planner.bound[scope] == label  # one failure of another kind: tried again
+    refused = ActionResult(ok=False, reason=FailureReason.NOT_GRASPABLE, feedback=f"{label} cannot be picked up")
+    planner._failed(planner._step.action, planner._step, refused)  # as if it were furniture
+    assert scope not in planner.bound and label in planner.dropped and planner._label(scope) != label
+
+
+def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
+    from more_agent.planners.base import EpisodeContext
+
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    fridge = planner.seen["fridge A"]
+    assert fridge.bbox.min[2] <= GROUND_M and _on_floor(planner.relation["fridge A"])  # it stands on the floor
+    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
+    item = planner.bound[scope]
+    assert not _on_floor(planner.relation[item])  # on a counter or inside a cabinet
+    floor = next(iter(planner.goal.floor_rooms))
+    assert planner._put_down(item).action.arguments[1] == FLOOR
+    planner.literals = [Literal("ontop", (scope, floor), negated=True)]
+    planner.relation[item] = ("ontop", f"{FLOOR} kitchen")
+    assert planner._holds(planner.literals[0]) is False
+    support = planner._put_down(item)
+    assert support.target is not None and support.target != item and is_furniture(planner.seen[support.target].category)

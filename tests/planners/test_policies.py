@@ -119,6 +119,25 @@ def test_agent_grid_blind_ring_bumps_and_goals_in_the_robots_component() -> None
     assert ring.is_free(1.6, 1.05) and not bumped.is_free(1.6, 1.05) and not bumped.is_free(1.45, 1.05)
 
 
+def test_the_robot_leaves_a_nook_of_its_map_the_way_it_came() -> None:
+    grid = np.full((40, 20), FREE)  # [ix, iy], 0.1 m cells; open floor at x < 2 m
+    grid[20:, :] = OCCUPIED
+    grid[20:31, 9:13] = FREE  # a slot 0.4 m wide: all of it within the 0.25 m inflation
+    grid[31:38, 7:15] = FREE  # a nook at its end, wide enough for free cells of its own
+    path = [(1.05 + 0.075 * k, 1.05) for k in range(33)]  # driven in by a magic action's final approach
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    sealed = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=path)
+    assert path_to_nearest(sealed, path[-1], [(0.5, 0.5)], snap_m=0.5)[1] is None  # the nook is an island of the map
+    nav = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=path, retrace=True)
+    assert nav.is_free(3.45, 1.05) and not nav.is_free(2.55, 0.95)  # the slot is free only along the path
+    result, index = path_to_nearest(nav, path[-1], [(0.5, 0.5)], snap_m=0.5)
+    assert index == 0 and result.found
+    grid[25, 10] = OCCUPIED  # something put down in the slot since: the way back is closed
+    blocked = agent_nav_grid(OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25,
+                             stood_xy=path, retrace=True)
+    assert path_to_nearest(blocked, path[-1], [(0.5, 0.5)], snap_m=0.5)[1] is None
+
+
 def test_the_graph_shows_the_hand_empty_right_after_a_floor_placement() -> None:
     _, body, graph = fresh()
     item = next(o for o in graph.objects.values() if o.category == "bottle_of_cooking_oil")

@@ -3,7 +3,11 @@
 Only cells the robot has seen free count as traversable, kept ``plan_inflation_m`` away from mapped
 obstacles (unknown space is not traversable but does not inflate), plus the unknown cells close to
 where the robot has stood: the pitched camera never sees the floor right around the robot, and
-without them the robot's own spot is a hole that cuts it off from the map it has seen. Shortest paths use the same
+without them the robot's own spot is a hole that cuts it off from the map it has seen. With
+``retrace``, the cells its centre has passed through are traversable too, inflation or not, unless mapped
+occupied since: a magic action's final approach drives on the ground truth with the robot's real radius
+and may leave it inside the inflation margin of its map (a gap between a counter and a table), where no
+path with the full margin leads out. Shortest paths use the same
 8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.navgrid.shortest_path`,
 an optimal search like A* with an admissible heuristic), here on what the agent knows.
 """
@@ -24,23 +28,26 @@ from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
 
 def agent_nav_grid(
     occupancy: OccupancyMap, *, inflation_m: float, stood_xy: Sequence[XY] = (), blind_radius_m: float = 0.0,
-    bumped_xy: Sequence[XY] = (),
+    bumped_xy: Sequence[XY] = (), retrace: bool = False,
 ) -> NavGrid:
     """The traversable raster of the agent's map: seen-free cells, and unknown cells within
     ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
-    ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed)."""
+    ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed);
+    with ``retrace``, also the cells of ``stood_xy`` themselves (the robot's path) that are not obstacles."""
     grid = np.array(occupancy.grid)
     bumps = _cells(occupancy, bumped_xy)
     grid[bumps[:, 0], bumps[:, 1]] = OCCUPIED
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
     known_free = grid == FREE
-    if len(stood_xy) and blind_radius_m > 0:
-        cells = _cells(occupancy, stood_xy)
+    path = _cells(occupancy, stood_xy)
+    if len(path) and blind_radius_m > 0:
         seeds = np.ones(grid.shape, dtype=bool)
-        seeds[cells[:, 0], cells[:, 1]] = False
+        seeds[path[:, 0], path[:, 1]] = False
         near = ndimage.distance_transform_edt(seeds) * occupancy.resolution_m <= blind_radius_m
         known_free |= near & (grid != OCCUPIED)
     free = known_free & (clearance > inflation_m)
+    if retrace:
+        free[path[:, 0], path[:, 1]] |= grid[path[:, 0], path[:, 1]] != OCCUPIED
     return NavGrid(
         origin_xy=occupancy.origin_xy, resolution_m=occupancy.resolution_m, free=free,
         closed_doors=frozenset(), door_cells={},

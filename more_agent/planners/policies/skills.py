@@ -18,10 +18,10 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from more_agent.scene_graph import ObjectNode, SceneGraph
+from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim import actions
 from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.sim.navgrid import XY
+from more_agent.sim.navgrid import XY, PathResult
 from more_agent.sim.world import floor_name
 from more_agent.skills import Skill, Subpolicy, skill_named
 
@@ -43,15 +43,27 @@ def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: flo
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
-        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
-                              blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps)
-        path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
+        path, index = _plan(body, occupancy, goals, snap_m)
         if index is None:
             return False, None, "no path on the map"
         if body.follow(path.waypoints):
             return True, index, ""
         occupancy = body.build().occupancy
     return False, None, "the way is blocked"
+
+
+def _plan(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float) -> tuple[PathResult, int | None]:
+    """Shortest path on the agent's map to the nearest reachable goal; when none is, the same with the
+    robot retracing its own path (``agent_nav_grid``'s ``retrace``): paths keep the full clearance
+    margin wherever they can, and the robot is never sealed in where a final approach left it."""
+    cfg = body.config
+    for retrace in (False, True):
+        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
+                              blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps, retrace=retrace)
+        path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
+        if index is not None:
+            break
+    return path, index
 
 
 def explore(body: Embodiment, graph: SceneGraph, region_id: str, room: str) -> ActionResult:
