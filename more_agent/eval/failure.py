@@ -88,7 +88,7 @@ def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goa
         others = sorted(t for t in touched - goal_refs
                         if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category)
         if others:
-            return f"acted on {', '.join(others)}; the goal needs {obj.label}"
+            return f"acted on {', '.join(others)}; the goal needs {obj.label or name + ' (never observed)'}"
     return ""
 
 

@@ -65,3 +65,12 @@ def test_summary_counts_causes_per_system(world: World) -> None:
     assert cause_counts(records) == {"never_observed": 1, "done_early": 1}
     md = summary_markdown(records)
     assert "| System | n | failures | never_observed | done_early |\n" in md and "| grounded | 3 | 2 | 1 | 1 |" in md
+
+
+def test_a_wrong_instance_names_a_needed_one_never_seen_by_its_world_name() -> None:
+    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
+    world.assign_labels()
+    world.get("bottom_cabinet_0").label = ""  # the needed cabinet was never seen, so never labelled
+    failure = classify_failure(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)]), world)
+    assert failure is not None and failure.cause == "wrong_instance"
+    assert failure.detail.endswith("the goal needs bottom_cabinet_0 (never observed)")
