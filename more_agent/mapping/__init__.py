@@ -5,7 +5,7 @@ Arrays are ``[ix, iy]`` on a :class:`Grid` (re-exported from :mod:`more_agent.si
 
 from more_agent.mapping.assignment import assign_objects, line_of_sight
 from more_agent.mapping.config import MappingConfig
-from more_agent.mapping.frontiers import frontier_points
+from more_agent.mapping.frontiers import frontier_points, visible_unknown_area
 from more_agent.mapping.graph import NavGraph
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN, VoxelMap, depth_to_points
 from more_agent.mapping.pipeline import RegionGraph, region_graph
@@ -26,5 +26,5 @@ __all__ = [
     "FREE", "OCCUPIED", "UNKNOWN", "DoorKernel", "Grid", "MappingConfig", "NavGraph", "RegionGraph", "VoxelMap",
     "assign_objects", "depth_to_points", "door_crossing_edges", "door_field", "doorway_mask", "fit_door_kernel",
     "frontier_points", "line_of_sight", "merge_subregions", "region_graph", "segment_regions", "sparsify",
-    "voronoi_graph",
+    "visible_unknown_area", "voronoi_graph",
 ]

@@ -21,9 +21,10 @@ Every step (MPC style) it rebuilds the scene graph and:
    hold things, not a laptop; three in a row at most while there is a room to explore), explores
    the room most likely to hold the missing furniture (BEHAVIOR-1K room inventories), a room whose
    explores still reveal new objects before the others, then the one explored least often, the
-   nearest; each explore drives to the frontiers farthest from the robot's path. A room whose last
-   two explores revealed nothing new yields to the other containers and closed doors; the planner
-   gives up with ``done`` when nothing is left to try.
+   nearest; each explore drives to the frontiers farthest from the robot's path, of those to the
+   ones with the most unseen floor in sensor range (information gain on the robot's own occupancy
+   map). A room whose last two explores revealed nothing new yields to the other containers and
+   closed doors; the planner gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
@@ -41,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from more_agent.mapping import visible_unknown_area
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.language import room_names
 from more_agent.planners.oracle import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
@@ -69,6 +71,9 @@ FRUITLESS_EXPLORES = 2
 
 FAR_FRONTIER_SHARE = 0.5
 """Explore goes to the frontiers at least this share as far from the robot's path as the farthest one."""
+
+INFORMATIVE_SHARE = 0.75
+"""... and of those, to the ones showing at least this share of the most unknown floor in sensor range."""
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
@@ -393,8 +398,19 @@ class GroundedPlanner:
         return self.fruitless[region] >= FRUITLESS_EXPLORES
 
     def _explore_step(self, region: str, note: str) -> _Step:
+        far = far_frontiers(self._graph().frontiers(region), self.body.trajectory)
         return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region,
-                     frontiers=far_frontiers(self._graph().frontiers(region), self.body.trajectory))
+                     frontiers=self._informative(far))
+
+    def _informative(self, frontiers: tuple[XY, ...]) -> tuple[XY, ...]:
+        """The frontiers from which the most unknown floor lies in sensor range (``INFORMATIVE_SHARE``):
+        a frontier at the edge of a large unseen area before one beside a corner nearly seen."""
+        occupancy = self._graph().occupancy
+        if occupancy is None or len(frontiers) < 2:
+            return frontiers
+        gain = visible_unknown_area(occupancy.grid, occupancy.frame, np.asarray(frontiers),
+                                    range_m=self.body.builder.config.max_range_m)
+        return tuple(f for f, g in zip(frontiers, gain) if g >= INFORMATIVE_SHARE * gain.max())
 
     def _put_down(self, held: str) -> _Step:
         """Free the hand: on the floor where the robot stands, unless the goal wants the item off that

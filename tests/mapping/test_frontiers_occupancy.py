@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from more_agent.mapping import Grid, VoxelMap, depth_to_points, frontier_points
+from more_agent.mapping import Grid, VoxelMap, depth_to_points, frontier_points, visible_unknown_area
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
 from tests.scene_graph.boxworld import CID, Box, camera_pose, intrinsics, render
 
@@ -16,6 +16,21 @@ def test_frontier_points_one_per_long_cluster() -> None:
     assert len(pts) == 1
     assert lengths[0] >= 2.0
     assert 1.0 + 20 * 0.1 <= pts[0, 0] <= 1.0 + 40 * 0.1 and abs(pts[0, 1] - (2.0 + 29.5 * 0.1)) < 1e-9
+
+
+def test_visible_unknown_area_is_the_unseen_floor_in_range_that_no_wall_hides() -> None:
+    grid = Grid(resolution_m=0.1)
+    unseen = np.full((100, 100), UNKNOWN, dtype=np.int8)
+    (alone,) = visible_unknown_area(unseen, grid, np.array([[5.0, 5.0]]), range_m=2.0)
+    assert abs(alone - np.pi * 2.0**2) < 0.5  # the whole disc in range
+    half = unseen.copy()
+    half[:50, :] = FREE  # the west half is seen
+    west, edge, east = visible_unknown_area(half, grid, np.array([[3.0, 5.0], [5.0, 5.0], [7.0, 5.0]]), range_m=2.0)
+    assert west == 0.0 and abs(edge - alone / 2) < 0.5 and abs(east - alone) < 0.5
+    walled = half.copy()
+    walled[50, :] = OCCUPIED  # a wall along the seen half's edge hides the rest
+    assert visible_unknown_area(walled, grid, np.array([[4.5, 5.0]]), range_m=2.0)[0] == 0.0
+    assert visible_unknown_area(half, grid, np.zeros((0, 2)), range_m=2.0).shape == (0,)
 
 
 def _vmap() -> VoxelMap:

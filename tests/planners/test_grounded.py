@@ -88,6 +88,27 @@ def test_explore_goes_to_the_frontiers_far_from_the_robots_path() -> None:
     assert far_frontiers([], path) == ()
 
 
+def test_explore_goes_to_the_frontiers_with_the_most_unseen_floor_in_range() -> None:
+    import numpy as np
+
+    from more_agent.mapping import FREE, UNKNOWN
+    from more_agent.planners.base import EpisodeContext
+    from more_agent.scene_graph import OccupancyMap
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    cells = np.full((400, 200), FREE, dtype=np.int8)  # 40 m x 20 m at 0.1 m, corner at the origin
+    cells[300:, :] = UNKNOWN  # a large unseen area east of x = 30 m
+    cells[:20, 95:105] = UNKNOWN  # a nook at the west edge, nearly seen
+    occupancy = OccupancyMap(grid=cells, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    planner.graph = planner._graph().model_copy(update={"occupancy": occupancy})
+    nook, open_edge, beside = (2.1, 10.0), (29.9, 10.0), (29.9, 2.0)
+    assert planner._informative((nook, open_edge, beside)) == (open_edge, beside)
+    assert planner._informative((nook,)) == (nook,)  # a single frontier is kept whatever it shows
+
+
 def test_unlisted_categories_do_not_rank_rooms() -> None:
     assert is_furniture("fridge") and not is_furniture("tennis_racket")
 
