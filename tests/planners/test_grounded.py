@@ -10,10 +10,10 @@ from more_agent.eval.episode import run_episode
 from more_agent.planners.base import default_planner, make_planner
 from more_agent.planners.grounded import FRUITLESS_EXPLORES, OPENS_BEFORE_EXPLORING, GroundedPlanner, far_frontiers
 from more_agent.planners.room_types import is_furniture, likely_room_type
-from more_agent.planners.task_goal import task_goal
+from more_agent.planners.task_goal import intended_goal, task_goal
 from more_agent.records import EpisodeSpec
 from more_agent.sim.goals import GoalChecker, GoalStatus
-from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
 
@@ -39,6 +39,19 @@ def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen:
     assert goal.named == {"electric_refrigerator.n.01_1": "fridge A", "cabinet.n.01_1": "bottom_cabinet A"}
     assert "fridge" in goal.categories["electric_refrigerator.n.01_1"]
     assert "egg.n.02_1" not in goal.named  # the description says "dairy", not which instance
+
+
+def test_a_forall_whose_body_names_one_scope_is_read_over_its_variable() -> None:
+    """recycling_office_papers quantifies over every legal document but names legal_document.n.01_1 in
+    the body: bddl checks one document no reader can tell apart, the reader puts all of them in the bin."""
+    typo = [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01_1", "?bin.n.01_1"]]]
+    assert intended_goal(typo) == [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01", "?bin.n.01_1"]]]
+    meant = [["forall", ["?x.n.01", "-", "x.n.01"], ["ontop", "?x.n.01", "?table.n.01_1"]], ["not", ["open", "?fridge.n.01_1"]]]
+    assert intended_goal(meant) == meant
+    papers = instantiate("recycling_office_papers", None, 1, start="task-room", distractors=False)
+    goal = task_goal(papers, GoalChecker(papers))
+    documents = {lit.args[0] for opt in goal.options for lit in opt}
+    assert documents == {"legal_document.n.01_1", "legal_document.n.01_2", "legal_document.n.01_3"}
 
 
 def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
