@@ -115,4 +115,79 @@ def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None
     planner.fruitless[step.region] = FRUITLESS_EXPLORES - 1
     assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
     planner.fruitless[step.region] = FRUITLESS_EXPLORES  # its last explores showed nothing new
+    planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
     assert planner._search(lit, None).action.name == "go_to_and_open"
+
+
+def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
+    """A floor literal holds for an object the scene graph shows on nothing: the planner does not pick it
+    up to put it down again (cleaning_up_branches_and_twigs: the trash can already stands on the lawn)."""
+    from more_agent.planners.base import EpisodeContext
+    from more_agent.sim.goals import Literal
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    floor = next(iter(planner.goal.floor_rooms))
+    planner.bound["bag"] = "paper_bag A"  # stands on the floor; the yogurt is inside it
+    planner.bound["yogurt"] = "cup_of_yogurt A"
+    assert planner._holds(Literal("ontop", ("bag", floor))) is True
+    assert planner._holds(Literal("ontop", ("yogurt", floor))) is False
+
+
+def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> None:
+    """Explores clear a store's floor, but items on a far shelf show only from close by: once the room of
+    the task's objects yields nothing new, the robot drives to its furniture it has not been near."""
+    from more_agent.planners.base import EpisodeContext
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"  # a task object: its room is a task room
+    room = planner.seen["cup_of_yogurt A"].region_id
+    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING
+    planner.fruitless[room] = FRUITLESS_EXPLORES
+    step = planner._search(planner.literals[0], None)
+    assert step.action.name == "navigate" and planner.seen[step.target].region_id == room
+    planner._step = step
+    planner.execute(step.action)
+    assert planner._search(planner.literals[0], None).target != step.target  # each piece once
+
+
+def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
+    """A task's objects are set out together: the room where some were found is searched on before a
+    room not explored yet (buying_groceries left the store for a bathroom with groceries unseen)."""
+    from more_agent.planners.base import EpisodeContext
+    from more_agent.scene_graph import RegionNode
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    graph = planner._graph()
+    room = graph.robot.region_id
+    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
+    planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
+    planner.explored[room], planner.fruitless[room] = 5, 1  # explored often, the last one without news
+    assert planner._room_to_explore([]) == other.id  # nothing of the task found yet: the fresh room
+    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
+    assert planner._room_to_explore([]) == room
+
+
+def test_when_only_closing_is_left_the_planner_closes() -> None:
+    """Closing waits for the other literals, not for the other closings (putting_dishes_away_after_cleaning:
+    every cabinet closed, two of them open, and the planner searched instead of closing)."""
+    from more_agent.planners.base import EpisodeContext
+    from more_agent.sim.goals import Literal
+
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    fridge, cabinet = (kitchen.scope[s] for s in ("electric_refrigerator.n.01_1", "cabinet.n.01_1"))
+    kitchen.world.set_open(fridge, True)
+    kitchen.world.set_open(cabinet, True)
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.literals = [Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True)]
+    planner.observe()
+    assert planner.decide().name == "go_to_and_close"
