@@ -11,17 +11,20 @@ Every step (MPC style) it rebuilds the scene graph and:
 1. binds each goal scope to an observed instance: the label the description names, else the
    nearest unbound instance of a category that counts as the scope's synset; bindings stay;
 2. evaluates every literal of the goal option on what it believes (observed open state and spatial
-   relations, its own placements on floors) and calls ``done`` when all hold;
+   relations; an object on no furniture rests on its room's floor) and calls ``done`` when all hold;
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place, put down what the hand holds but does
    not need;
 4. when a needed object is unseen: opens the closed containers of the robot's room (three in a row
    at most while there is a room to explore), explores the room most likely to hold the missing
-   furniture (BEHAVIOR-1K room inventories), a room whose explores still reveal new objects before
-   the others, then the one explored least often, the nearest; each explore drives to the frontiers
-   farthest from the robot's path. A room whose last two explores revealed nothing new yields to the
-   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
+   furniture (BEHAVIOR-1K room inventories), a room where the task's items were found (they are set
+   out together) before the others, a room whose explores still reveal new objects before the rest,
+   then the one explored least often, the nearest; each explore drives to the frontiers farthest from
+   the robot's path. Before the search leaves the rooms of the task's items (or when their explores
+   reveal nothing new) it drives to their tables, shelves and counters it has not been near, where
+   small items show only from close by. A room whose last two explores revealed nothing new yields to
+   the other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. Regions are labelled
@@ -373,7 +376,7 @@ class GroundedPlanner:
         candidates = [
             o for o in self._graph().objects.values()
             if o.region_id in rooms and o.open is None and is_surface(o.category) and o.label not in self.looked_at
-            and o.label not in self.dropped and _gap(o, path) > LOOK_AT_M
+            and o.label not in self.dropped and _far_corner_gap(o, path) > LOOK_AT_M
         ]
         xy = self.body.xy
         return min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label)).label if candidates else None
@@ -385,9 +388,10 @@ class GroundedPlanner:
 
     def _room_to_explore(self, missing: list[str]) -> str | None:
         """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
-        new last; then the room most likely to hold the missing furniture; then a room whose explores
-        still reveal new objects before one not explored yet (a garden or a store is searched through,
-        not left after a few metres); then the least explored, the nearest."""
+        new last; then the room most likely to hold the missing furniture; then the rooms of the task's
+        items found so far (``_task_rooms``); then a room whose explores still reveal new objects before
+        one not explored yet (a garden or a store is searched through, not left after a few metres);
+        then the least explored, the nearest."""
         graph = self._graph()
         cats = [c for s in missing for c in self.goal.categories.get(s, ()) if is_furniture(c)]
         task_rooms = self._task_rooms()
@@ -489,7 +493,7 @@ def _on_floor(rel: Relation | None) -> bool:
     return rel is not None and rel[1].startswith(f"{FLOOR} ")
 
 
-def _gap(obj: ObjectNode, path: np.ndarray) -> float:
+def _far_corner_gap(obj: ObjectNode, path: np.ndarray) -> float:
     """How far the corner of ``obj``'s footprint farthest from ``path`` (n x 2) is from it: a long shelf
     passed at one end still has its other end to show."""
     if not len(path):

@@ -7,12 +7,13 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import run_episode
-from more_agent.planners.base import default_planner, make_planner
+from more_agent.planners.base import EpisodeContext, default_planner, make_planner
 from more_agent.planners.grounded import FRUITLESS_EXPLORES, OPENS_BEFORE_EXPLORING, GroundedPlanner, far_frontiers
 from more_agent.planners.room_types import is_furniture, likely_room_type
 from more_agent.planners.task_goal import intended_goal, task_goal
 from more_agent.records import EpisodeSpec
-from more_agent.sim.goals import GoalChecker, GoalStatus
+from more_agent.scene_graph import RegionNode
+from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
 from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
@@ -27,9 +28,22 @@ class BlindGoals(GoalChecker):
         raise AssertionError("the grounded planner checked the goal")
 
 
+def fresh_kitchen() -> TaskInstance:
+    """The kitchen task in a world no other test has acted in."""
+    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+
+
+def planner_in(kitchen: TaskInstance) -> GroundedPlanner:
+    """A grounded planner reset in ``kitchen`` (the goal checker refuses to be asked) after its first observation."""
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    return planner
+
+
 @pytest.fixture(scope="module")
 def kitchen() -> TaskInstance:
-    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    return fresh_kitchen()
 
 
 def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen: TaskInstance) -> None:
@@ -55,8 +69,6 @@ def test_a_forall_whose_body_names_one_scope_is_read_over_its_variable() -> None
 
 
 def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
-    from more_agent.planners.base import EpisodeContext
-
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     actions = []
@@ -102,12 +114,7 @@ def test_unlisted_categories_do_not_rank_rooms() -> None:
 
 
 def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None:
-    from more_agent.planners.base import EpisodeContext
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.observe()
+    planner = planner_in(fresh_kitchen())
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
     lit = planner.literals[0]
     step = planner._search(lit, None)
@@ -122,13 +129,7 @@ def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None
 def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
     """A floor literal holds for an object the scene graph shows on nothing: the planner does not pick it
     up to put it down again (cleaning_up_branches_and_twigs: the trash can already stands on the lawn)."""
-    from more_agent.planners.base import EpisodeContext
-    from more_agent.sim.goals import Literal
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.observe()
+    planner = planner_in(fresh_kitchen())
     floor = next(iter(planner.goal.floor_rooms))
     planner.bound["bag"] = "paper_bag A"  # stands on the floor; the yogurt is inside it
     planner.bound["yogurt"] = "cup_of_yogurt A"
@@ -139,12 +140,7 @@ def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
 def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> None:
     """Explores clear a store's floor, but items on a far shelf show only from close by: once the room of
     the task's objects yields nothing new, the robot drives to its furniture it has not been near."""
-    from more_agent.planners.base import EpisodeContext
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.observe()
+    planner = planner_in(fresh_kitchen())
     assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"  # a task object: its room is a task room
     room = planner.seen["cup_of_yogurt A"].region_id
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING
@@ -159,13 +155,7 @@ def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> 
 def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
     """A task's objects are set out together: the room where some were found is searched on before a
     room not explored yet (buying_groceries left the store for a bathroom with groceries unseen)."""
-    from more_agent.planners.base import EpisodeContext
-    from more_agent.scene_graph import RegionNode
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.observe()
+    planner = planner_in(fresh_kitchen())
     graph = planner._graph()
     room = graph.robot.region_id
     other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
@@ -179,15 +169,9 @@ def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
 def test_when_only_closing_is_left_the_planner_closes() -> None:
     """Closing waits for the other literals, not for the other closings (putting_dishes_away_after_cleaning:
     every cabinet closed, two of them open, and the planner searched instead of closing)."""
-    from more_agent.planners.base import EpisodeContext
-    from more_agent.sim.goals import Literal
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
-    fridge, cabinet = (kitchen.scope[s] for s in ("electric_refrigerator.n.01_1", "cabinet.n.01_1"))
-    kitchen.world.set_open(fridge, True)
-    kitchen.world.set_open(cabinet, True)
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    kitchen = fresh_kitchen()
+    for scope in ("electric_refrigerator.n.01_1", "cabinet.n.01_1"):
+        kitchen.world.set_open(kitchen.scope[scope], True)
+    planner = planner_in(kitchen)
     planner.literals = [Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True)]
-    planner.observe()
     assert planner.decide().name == "go_to_and_close"
