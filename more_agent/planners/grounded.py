@@ -120,6 +120,8 @@ class GroundedPlanner:
         self.looked_into: set[str] = set()
         self.looked_at: set[str] = set()
         """Furniture driven to in search of a missing item (``_furniture_to_look_at``)."""
+        self.fruitless_looks = 0
+        """Such drives in a row that revealed no new object (the search stops them at ``FRUITLESS_EXPLORES``)."""
         self.dropped: set[str] = set()
         self.out_of_reach: dict[str, int] = {}
         """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
@@ -371,7 +373,9 @@ class GroundedPlanner:
     def _furniture_to_look_at(self) -> str | None:
         """The nearest furniture things are put on (tables, shelves, counters: ``sim.clutter.is_surface``)
         of the task's rooms the robot has not been near (``LOOK_AT_M``): explore() clears a store's floor,
-        but groceries on a far shelf show only from close by."""
+        but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
+        if self.fruitless_looks >= FRUITLESS_EXPLORES:
+            return None
         rooms, path = self._task_rooms(), np.asarray(self.body.trajectory[::4], dtype=float)
         candidates = [
             o for o in self._graph().objects.values()
@@ -455,8 +459,12 @@ class GroundedPlanner:
             self.relation[held.label] = self._on_floor_of(step.region or graph.robot.region_id)
         elif result.ok and action.name == "go_to_and_open":
             self.looked_into.add(step.target)
+        news = len(body.observed) > known
+        self.fruitless_looks = 0 if news else self.fruitless_looks + (action.name == "navigate")
         if action.name == "navigate":
             self.looked_at.add(step.target)
+            if news:  # its room shows more: explore it again
+                self.fruitless[graph.objects[step.target].region_id or ""] = 0
         if not result.ok:
             self._failed(action, step, result)
         return result

@@ -6,8 +6,8 @@ scope may be, the instance labels the description names (``apple A``), and the r
 floor scope the description names ("the kitchen floor"). Nothing here reads world state: scopes
 are matched to scene-graph objects by the planner, through what the robot observes.
 
-The goal is read as its author meant it (:func:`intended_goal`): ten bddl activities quantify over
-a variable their body never uses, e.g. recycling_office_papers ``(forall (?legal_document.n.01 -
+The goal is read as its author meant it (:func:`intended_goal`): eight bddl activities have a
+``forall`` over a variable its body never uses, e.g. recycling_office_papers ``(forall (?legal_document.n.01 -
 legal_document.n.01) (inside ?legal_document.n.01_1 ?recycling_bin.n.01_1))``, which bddl checks as
 "legal_document.n.01_1 is in the bin", one document no reader can tell from the others ("throw all
 legal documents in the recycling bin"). Read as written by intent, every document goes in the bin,
@@ -93,7 +93,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
 def intended_goal(parsed: list[Any]) -> list[Any]:
     """``parsed`` (bddl's goal parse) with every ``forall`` whose body names a scope of the quantified
     synset (``?legal_document.n.01_1``) but never its variable (``?legal_document.n.01``) made to
-    range over its variable: the typo of ten bddl activities (module docstring)."""
+    range over its variable: the typo of eight bddl activities (module docstring)."""
     if not isinstance(parsed, list):
         return parsed
     if len(parsed) == 3 and parsed[0] == "forall":
