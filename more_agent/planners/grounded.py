@@ -307,6 +307,8 @@ class GroundedPlanner:
         a = self.bound[subject]
         if a not in objects:
             return None
+        if lit.negated and self.goal.is_floor(target):
+            return None  # off the floor: putting it down again cannot do it, a placement elsewhere does
         if not lit.negated and not self.goal.is_floor(target):
             b = self.bound[target]
             if b not in objects:

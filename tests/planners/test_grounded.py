@@ -175,3 +175,12 @@ def test_when_only_closing_is_left_the_planner_closes() -> None:
     planner = planner_in(kitchen)
     planner.literals = [Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True)]
     assert planner.decide().name == "go_to_and_close"
+
+
+def test_an_object_that_must_leave_the_floor_is_not_picked_up_to_be_put_down_again() -> None:
+    """(not (ontop sod lawn)) is met by the placement elsewhere the goal asks for; putting the sod down
+    where the robot stands never meets it (remove_sod looped on grasp and put down)."""
+    planner = planner_in(fresh_kitchen())
+    floor = next(iter(planner.goal.floor_rooms))
+    planner.bound["bag"] = "paper_bag A"
+    assert planner._act_for(Literal("ontop", ("bag", floor), True), None) is None
