@@ -19,12 +19,15 @@ Every step (MPC style) it rebuilds the scene graph and:
    not need (on the floor, or on low furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore), explores
-   the room most likely to hold the missing furniture (BEHAVIOR-1K room inventories), a room whose
-   explores still reveal new objects before the others, then the one explored least often, the
+   the room most likely to hold the missing furniture (BEHAVIOR-1K room inventories), a room where
+   the task's items were found (they are set out together) before the others, a room whose
+   explores still reveal new objects before the rest, then the one explored least often, the
    nearest; each explore drives to the frontiers farthest from the robot's path, of those to the
    ones with the most unseen floor in sensor range (information gain on the robot's own occupancy
-   map). A room whose last two explores revealed nothing new yields to the other containers and
-   closed doors; the planner gives up with ``done`` when nothing is left to try.
+   map). Before the search leaves the rooms of the task's items (or when their explores reveal
+   nothing new) it drives to their tables, shelves and counters it has not been near, where small
+   items show only from close by. A room whose last two explores revealed nothing new yields to the
+   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
@@ -54,6 +57,7 @@ from more_agent.records import LLMUsage
 from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.catalog import can_hold_things
+from more_agent.sim.clutter import is_surface
 from more_agent.sim.goals import Literal
 from more_agent.sim.navgrid import XY
 
@@ -74,6 +78,10 @@ FAR_FRONTIER_SHARE = 0.5
 
 INFORMATIVE_SHARE = 0.75
 """... and of those, to the ones showing at least this share of the most unknown floor in sensor range."""
+
+LOOK_AT_M = 2.0
+"""Furniture of the task's rooms with a corner farther than this from everywhere the robot has been is
+driven to when an item is missing."""
 
 MAX_REACH_FAILURES = 3
 """An object is given up after this many failed approaches (the robot explores in between)."""
@@ -123,6 +131,10 @@ class GroundedPlanner:
         self.relation: dict[str, Relation | None] = {}
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
+        self.looked_at: set[str] = set()
+        """Furniture driven to in search of a missing item (``_furniture_to_look_at``)."""
+        self.fruitless_looks = 0
+        """Such drives in a row that revealed no new object (the search stops them at ``FRUITLESS_EXPLORES``)."""
         self.dropped: set[str] = set()
         self.out_of_reach: dict[str, int] = {}
         """Label -> trajectory length when an approach failed: skipped until the robot has moved since."""
@@ -211,9 +223,11 @@ class GroundedPlanner:
         """The floor of its room when the object's box reaches the ground (``GROUND_M``): the scene graph
         relates objects to objects only, and without this an item lying on a lawn would be believed
         off it."""
-        if obj.bbox.min[2] > GROUND_M:
-            return None
-        return "ontop", f"{FLOOR} {self.room_types.get(obj.region_id or '', '')}"
+        return None if obj.bbox.min[2] > GROUND_M else self._on_floor_of(obj.region_id)
+
+    def _on_floor_of(self, region: str | None) -> Relation:
+        """The relation of an object resting on the floor of ``region``, named by its room type."""
+        return ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
 
     def _floor_region(self, scope: str) -> str | None:
         """A reachable region whose room type is the floor's (any region when the description names none)."""
@@ -265,8 +279,9 @@ class GroundedPlanner:
             step = self._place_held(held.label, [lit for lit, h in pending if h is False])
             if step is not None:
                 return step
+        only_closing = all(_closes(lit) for lit, _ in pending)
         for lit, h in pending:
-            if lit.predicate == "open" and lit.negated and len(pending) > 1:
+            if _closes(lit) and not only_closing:
                 continue  # close last: what is inside may still be needed
             if h is False:
                 step = self._act_for(lit, held.label if held is not None else None)
@@ -311,6 +326,8 @@ class GroundedPlanner:
         a = self.bound[subject]
         if a not in objects:
             return None
+        if lit.negated and self.goal.is_floor(target) and (self._placed_elsewhere(subject) or self._support_for(a) is None):
+            return None  # the placement the goal asks for meets it; putting it down again cannot
         if not lit.negated and not self.goal.is_floor(target):
             b = self.bound[target]
             if b not in objects:
@@ -357,6 +374,10 @@ class GroundedPlanner:
         region = self._room_to_explore(missing)
         if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
             return self._open_to_look(closed[0].label, held, note)
+        if region is None or self._stale(region) or region not in self._task_rooms():
+            furniture = self._furniture_to_look_at()
+            if furniture is not None:
+                return self._object_step("navigate", furniture, note)
         if region is not None and not self._stale(region):
             return self._explore_step(region, note)
         if closed:
@@ -370,6 +391,21 @@ class GroundedPlanner:
         why = f"{note}: nothing left to explore or open"
         return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
+    def _furniture_to_look_at(self) -> str | None:
+        """The nearest furniture things are put on (tables, shelves, counters: ``sim.clutter.is_surface``)
+        of the task's rooms the robot has not been near (``LOOK_AT_M``): explore() clears a store's floor,
+        but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
+        if self.fruitless_looks >= FRUITLESS_EXPLORES:
+            return None
+        rooms, path = self._task_rooms(), np.asarray(self.body.trajectory[::4], dtype=float)
+        candidates = [
+            o for o in self._graph().objects.values()
+            if o.region_id in rooms and o.open is None and is_surface(o.category) and o.label not in self.looked_at
+            and o.label not in self.dropped and _far_corner_gap(o, path) > LOOK_AT_M
+        ]
+        xy = self.body.xy
+        return min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label)).label if candidates else None
+
     def _open_to_look(self, label: str, held: str | None, note: str) -> _Step:
         if held is not None:
             return self._put_down(held)
@@ -377,21 +413,30 @@ class GroundedPlanner:
 
     def _room_to_explore(self, missing: list[str]) -> str | None:
         """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
-        new last; then the room most likely to hold the missing furniture; then a room whose explores
-        still reveal new objects before one not explored yet (a garden or a store is searched through,
-        not left after a few metres); then the least explored, the nearest."""
+        new last; then the room most likely to hold the missing furniture; then the rooms of the task's
+        items found so far (``_task_rooms``); then a room whose explores still reveal new objects before
+        one not explored yet (a garden or a store is searched through, not left after a few metres);
+        then the least explored, the nearest."""
         graph = self._graph()
         cats = [c for s in missing for c in self.goal.categories.get(s, ()) if is_furniture(c)]
+        task_rooms = self._task_rooms()
 
-        def score(rid: str) -> tuple[bool, float, bool, int, float, str]:
+        def score(rid: str) -> tuple[bool, float, bool, bool, int, float, str]:
             kind = self.room_types.get(rid)
             like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
             productive = self.explored[rid] > 0 and self.fruitless[rid] == 0
-            return (self._stale(rid), -like, not productive, self.explored[rid],
+            return (self._stale(rid), -like, rid not in task_rooms, not productive, self.explored[rid],
                     math.dist(graph.regions[rid].centroid, self.body.xy), rid)
 
         open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
         return min(open_regions, key=score) if open_regions else None
+
+    def _task_rooms(self) -> set[str]:
+        """Regions of the objects found so far that the goal moves: a task's items are set out together
+        (a store's groceries, a kitchen's food), so its other items are likeliest there. Furniture a goal
+        only names as a target (any cabinet the plates may go in) tells nothing of where they are."""
+        moved = {lit.args[0] for lit in self.literals if lit.predicate != "open"}
+        return {self.seen[self.bound[s]].region_id for s in moved if s in self.bound} - {None}
 
     def _stale(self, region: str) -> bool:
         """Whether the region's last explores revealed no object not seen before."""
@@ -429,6 +474,10 @@ class GroundedPlanner:
         return any(lit.negated and lit.predicate == "ontop" and self.goal.is_floor(lit.args[1])
                    and self.bound.get(lit.args[0]) == held and self.goal.floor_rooms[lit.args[1]] in (None, kind)
                    for lit in self.literals)
+
+    def _placed_elsewhere(self, scope: str) -> bool:
+        """Whether a goal literal places ``scope`` somewhere (which takes it off any floor it must leave)."""
+        return any(not lit.negated and lit.predicate != "open" and lit.args[0] == scope for lit in self.literals)
 
     def _support_for(self, held: str) -> str | None:
         """The nearest reachable observed furniture to put ``held`` on top of: low enough to reach
@@ -468,10 +517,15 @@ class GroundedPlanner:
             self.explored[step.region] += 1
             self.fruitless[step.region] = 0 if len(body.observed) > known else self.fruitless[step.region] + 1
         elif step.target is None and result.ok and held is not None:  # put on a floor
-            region = step.region or graph.robot.region_id
-            self.relation[held.label] = ("ontop", f"{FLOOR} {self.room_types.get(region or '', '')}")
+            self.relation[held.label] = self._on_floor_of(step.region or graph.robot.region_id)
         elif result.ok and action.name == "go_to_and_open":
             self.looked_into.add(step.target)
+        news = len(body.observed) > known
+        self.fruitless_looks = 0 if news else self.fruitless_looks + (action.name == "navigate")
+        if action.name == "navigate":
+            self.looked_at.add(step.target)
+            if news:  # its room shows more: explore it again
+                self.fruitless[graph.objects[step.target].region_id or ""] = 0
         if not result.ok:
             self._failed(action, step, result)
         return result
@@ -502,8 +556,22 @@ class GroundedPlanner:
         return self.graph
 
 
+def _closes(lit: Literal) -> bool:
+    return lit.predicate == "open" and lit.negated
+
+
 def _on_floor(rel: Relation | None) -> bool:
     return rel is not None and rel[1].startswith(f"{FLOOR} ")
+
+
+def _far_corner_gap(obj: ObjectNode, path: np.ndarray) -> float:
+    """How far the corner of ``obj``'s footprint farthest from ``path`` (n x 2) is from it: a long shelf
+    passed at one end still has its other end to show."""
+    if not len(path):
+        return math.inf
+    (x0, y0), (x1, y1) = obj.bbox.min[:2], obj.bbox.max[:2]
+    corners = np.array([(x0, y0), (x0, y1), (x1, y0), (x1, y1)], dtype=float)
+    return float(np.sqrt(((corners[:, None, :] - path[None, :, :]) ** 2).sum(axis=2)).min(axis=1).max())
 
 
 def far_frontiers(frontiers: Sequence[XY], path: Sequence[XY]) -> tuple[XY, ...]:

@@ -6,12 +6,21 @@ scope may be, the instance labels the description names (``apple A``), the room 
 scope the description names ("the kitchen floor") and which scopes the goal moves. Nothing here
 reads world state: scopes are matched to scene-graph objects by the planner, through what the robot
 observes.
+
+The goal is read as its author meant it (:func:`intended_goal`): eight bddl activities have a
+``forall`` over a variable its body never uses, e.g. recycling_office_papers ``(forall (?legal_document.n.01 -
+legal_document.n.01) (inside ?legal_document.n.01_1 ?recycling_bin.n.01_1))``, which bddl checks as
+"legal_document.n.01_1 is in the bin", one document no reader can tell from the others ("throw all
+legal documents in the recycling bin"). Read as written by intent, every document goes in the bin,
+which satisfies the goal whichever one bddl means.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
@@ -56,6 +65,9 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
     as written, not which world object a scope is.
     """
     to_scope = {world: scope for scope, world in instance.scope.items()}
+    intended = intended_goal(instance.definition.goal)
+    if intended != instance.definition.goal:
+        goals = GoalChecker(instance, goal=intended)
     options = tuple(
         tuple(Literal(lit.predicate, tuple(to_scope.get(a, a) for a in lit.args), lit.negated)
               for lit in goals.ground_literals(i))
@@ -82,4 +94,29 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
             named[scope] = instance.label(scope)
     return TaskGoal(options=options, categories=categories, named=named, floor_rooms=floors, robot=robot,
                     moved=frozenset(moved))
+
+
+def intended_goal(parsed: list[Any]) -> list[Any]:
+    """``parsed`` (bddl's goal parse) with every ``forall`` whose body names a scope of the quantified
+    synset (``?legal_document.n.01_1``) but never its variable (``?legal_document.n.01``) made to
+    range over its variable: the typo of eight bddl activities (module docstring)."""
+    if not isinstance(parsed, list):
+        return parsed
+    if len(parsed) == 3 and parsed[0] == "forall":
+        variable = parsed[1][0]
+        body = parsed[2]
+        if variable not in _terms(body):
+            own_scope = re.compile(rf"{re.escape(variable)}_\d+")
+            body = _renamed(body, lambda a: variable if own_scope.fullmatch(a) else a)
+        return ["forall", parsed[1], intended_goal(body)]
+    return [intended_goal(p) for p in parsed]
+
+
+def _terms(parsed: Any) -> set[str]:
+    """Every string anywhere in a parse tree."""
+    return {parsed} if isinstance(parsed, str) else set().union(*(_terms(p) for p in parsed))
+
+
+def _renamed(parsed: Any, rename: Callable[[str], str]) -> Any:
+    return rename(parsed) if isinstance(parsed, str) else [_renamed(p, rename) for p in parsed]
 

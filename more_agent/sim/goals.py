@@ -10,6 +10,7 @@ progress (TP). The oracle reads the same option as structured ``Literal``s.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -74,10 +75,14 @@ class GoalError(UserError):
 class GoalChecker:
     """Evaluates one task instance's goal on a world (the instance's own, or another of the same task)."""
 
-    def __init__(self, instance: TaskInstance) -> None:
+    def __init__(self, instance: TaskInstance, goal: list[Any] | None = None) -> None:
+        """``goal`` replaces the task's parsed goal (a reading of it, ``planners.task_goal``)."""
         self.backend = WorldBackend(instance.world)
         self.scope = instance.scope_objects()
         conds = instance.definition.conditions
+        if goal is not None:
+            conds = copy.copy(conds)
+            conds.parsed_goal_conditions = goal
         goal = get_goal_conditions(conds, self.backend, dict(self.scope))
         if not goal:
             raise ValueError(f"task {instance.task} has an empty goal")

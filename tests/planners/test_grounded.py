@@ -7,13 +7,14 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import run_episode
-from more_agent.planners.base import HighLevelAction, default_planner, make_planner
+from more_agent.planners.base import EpisodeContext, HighLevelAction, default_planner, make_planner
 from more_agent.planners.grounded import (
     FLOOR, FRUITLESS_EXPLORES, GROUND_M, OPENS_BEFORE_EXPLORING, GroundedPlanner, _on_floor, _Step, far_frontiers,
 )
 from more_agent.planners.room_types import is_furniture, likely_room_type
-from more_agent.planners.task_goal import task_goal
+from more_agent.planners.task_goal import intended_goal, task_goal
 from more_agent.records import EpisodeSpec
+from more_agent.scene_graph import RegionNode
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
@@ -31,9 +32,22 @@ class BlindGoals(GoalChecker):
         raise AssertionError("the grounded planner checked the goal")
 
 
+def fresh_kitchen() -> TaskInstance:
+    """The kitchen task in a world no other test has acted in."""
+    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+
+
+def planner_in(kitchen: TaskInstance) -> GroundedPlanner:
+    """A grounded planner reset in ``kitchen`` (the goal checker refuses to be asked) after its first observation."""
+    planner = GroundedPlanner()
+    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    planner.observe()
+    return planner
+
+
 @pytest.fixture(scope="module")
 def kitchen() -> TaskInstance:
-    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    return fresh_kitchen()
 
 
 def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen: TaskInstance) -> None:
@@ -45,9 +59,20 @@ def test_task_goal_is_over_scopes_with_the_labels_the_description_names(kitchen:
     assert "egg.n.02_1" not in goal.named  # the description says "dairy", not which instance
 
 
-def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
-    from more_agent.planners.base import EpisodeContext
+def test_a_forall_whose_body_names_one_scope_is_read_over_its_variable() -> None:
+    """recycling_office_papers quantifies over every legal document but names legal_document.n.01_1 in
+    the body: bddl checks one document no reader can tell apart, the reader puts all of them in the bin."""
+    typo = [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01_1", "?bin.n.01_1"]]]
+    assert intended_goal(typo) == [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01", "?bin.n.01_1"]]]
+    meant = [["forall", ["?x.n.01", "-", "x.n.01"], ["ontop", "?x.n.01", "?table.n.01_1"]], ["not", ["open", "?fridge.n.01_1"]]]
+    assert intended_goal(meant) == meant
+    papers = instantiate("recycling_office_papers", None, 1, start="task-room", distractors=False)
+    goal = task_goal(papers, GoalChecker(papers))
+    documents = {lit.args[0] for opt in goal.options for lit in opt}
+    assert documents == {"legal_document.n.01_1", "legal_document.n.01_2", "legal_document.n.01_3"}
 
+
+def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     actions = []
@@ -114,12 +139,7 @@ def test_unlisted_categories_do_not_rank_rooms() -> None:
 
 
 def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None:
-    from more_agent.planners.base import EpisodeContext
-
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
-    planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
-    planner.observe()
+    planner = planner_in(fresh_kitchen())
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
     lit = planner.literals[0]
     step = planner._search(lit, None)
@@ -127,6 +147,7 @@ def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None
     planner.fruitless[step.region] = FRUITLESS_EXPLORES - 1
     assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
     planner.fruitless[step.region] = FRUITLESS_EXPLORES  # its last explores showed nothing new
+    planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
     assert planner._search(lit, None).action.name == "go_to_and_open"
 
 
@@ -141,8 +162,6 @@ def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
 
 
 def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
-    from more_agent.planners.base import EpisodeContext
-
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     planner.observe()
@@ -158,8 +177,6 @@ def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInst
 
 
 def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
-    from more_agent.planners.base import EpisodeContext
-
     planner = GroundedPlanner()
     planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
     planner.observe()
@@ -175,3 +192,64 @@ def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off
     assert planner._holds(planner.literals[0]) is False
     support = planner._put_down(item)
     assert support.target is not None and support.target != item and is_furniture(planner.seen[support.target].category)
+
+
+def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
+    """A floor literal holds for an object the scene graph shows on nothing: the planner does not pick it
+    up to put it down again (cleaning_up_branches_and_twigs: the trash can already stands on the lawn)."""
+    planner = planner_in(fresh_kitchen())
+    floor = next(iter(planner.goal.floor_rooms))
+    planner.bound["bag"] = "paper_bag A"  # stands on the floor; the yogurt is inside it
+    planner.bound["yogurt"] = "cup_of_yogurt A"
+    assert planner._holds(Literal("ontop", ("bag", floor))) is True
+    assert planner._holds(Literal("ontop", ("yogurt", floor))) is False
+
+
+def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> None:
+    """Explores clear a store's floor, but items on a far shelf show only from close by: once the room of
+    the task's objects yields nothing new, the robot drives to its furniture it has not been near."""
+    planner = planner_in(fresh_kitchen())
+    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"  # a task object: its room is a task room
+    room = planner.seen["cup_of_yogurt A"].region_id
+    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING
+    planner.fruitless[room] = FRUITLESS_EXPLORES
+    step = planner._search(planner.literals[0], None)
+    assert step.action.name == "navigate" and planner.seen[step.target].region_id == room
+    planner._step = step
+    planner.execute(step.action)
+    assert planner._search(planner.literals[0], None).target != step.target  # each piece once
+
+
+def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
+    """A task's objects are set out together: the room where some were found is searched on before a
+    room not explored yet (buying_groceries left the store for a bathroom with groceries unseen)."""
+    planner = planner_in(fresh_kitchen())
+    graph = planner._graph()
+    room = graph.robot.region_id
+    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
+    planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
+    planner.explored[room], planner.fruitless[room] = 5, 1  # explored often, the last one without news
+    assert planner._room_to_explore([]) == other.id  # nothing of the task found yet: the fresh room
+    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
+    assert planner._room_to_explore([]) == room
+
+
+def test_when_only_closing_is_left_the_planner_closes() -> None:
+    """Closing waits for the other literals, not for the other closings (putting_dishes_away_after_cleaning:
+    every cabinet closed, two of them open, and the planner searched instead of closing)."""
+    kitchen = fresh_kitchen()
+    for scope in ("electric_refrigerator.n.01_1", "cabinet.n.01_1"):
+        kitchen.world.set_open(kitchen.scope[scope], True)
+    planner = planner_in(kitchen)
+    planner.literals = [Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True)]
+    assert planner.decide().name == "go_to_and_close"
+
+
+def test_an_object_that_must_leave_the_floor_is_not_picked_up_to_be_put_down_again() -> None:
+    """(not (ontop sod lawn)) is met by the placement elsewhere the goal asks for; putting the sod down
+    where the robot stands never meets it (remove_sod looped on grasp and put down)."""
+    planner = planner_in(fresh_kitchen())
+    floor = next(iter(planner.goal.floor_rooms))
+    planner.bound["bag"], planner.bound["counter"] = "paper_bag A", "countertop A"
+    planner.literals = [Literal("ontop", ("bag", floor), True), Literal("ontop", ("bag", "counter"))]
+    assert planner._act_for(planner.literals[0], None) is None
