@@ -26,7 +26,7 @@ from pathlib import Path
 from more_agent import __version__
 from more_agent.eval.failure import cause_counts, is_reach_failure
 from more_agent.eval.harness import evaluate
-from more_agent.eval.metrics import summarize
+from more_agent.eval.metrics import MetricSummary, summarize
 from more_agent.eval.report import SourcedRecord
 from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import RunConfig
@@ -41,16 +41,15 @@ def unambiguous(records: list[EpisodeRecord]) -> list[EpisodeRecord]:
     return [r for r in records if r.world_stats is not None and not r.world_stats.ambiguous_scopes]
 
 
-def row(task_set_name: str, planner: str, records: list[EpisodeRecord]) -> dict[str, object]:
-    """The JSON line of one (task set, planner)."""
-    s, clear = summarize(records), unambiguous(records)
+def row(task_set_name: str, planner: str, records: list[EpisodeRecord], s: MetricSummary, clear: MetricSummary) -> dict[str, object]:
+    """The JSON line of one (task set, planner), with its summaries over all episodes and the unambiguous ones."""
     steps = sum(r.high_level_steps for r in records)
     reach = sum(is_reach_failure(a) for r in records for a in r.actions)
     plan_ms = [1000 * r.timings.get("plan", 0.0) / r.high_level_steps for r in records if r.high_level_steps]
     return {
         "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
         "sr": round(100 * s.SR.mean, 1), "tp": round(100 * s.TP.mean, 1),
-        "n_unambiguous": len(clear), "sr_unambiguous": round(100 * summarize(clear).SR.mean, 1) if clear else None,
+        "n_unambiguous": clear.n, "sr_unambiguous": round(100 * clear.SR.mean, 1) if clear.n else None,
         "successes_per_seed": {seed: sum(r.success for r in records if r.seed == seed)
                                for seed in sorted({r.seed for r in records})},
         "high_level_steps": steps,
@@ -77,7 +76,7 @@ def main() -> None:
 
     for name in args.task_sets:
         tasks = task_set(name)[: args.limit]
-        results: dict[str, list[EpisodeRecord]] = {}
+        results: dict[str, tuple[MetricSummary, MetricSummary]] = {}
         for planner in args.planners:
             config = RunConfig(
                 planner=planner, tasks=tasks, seeds=list(range(args.seeds)), episode_fn="more_agent.eval.episode:run_episode",
@@ -86,11 +85,10 @@ def main() -> None:
             run_dir = args.out / (args.start if args.distractors else f"{args.start}-no-distractors") / name / planner
             records = evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
             write_reports([SourcedRecord(r, run_dir) for r in records], run_dir, title=f"{planner} on {name}")
-            results[planner] = records
-            print(json.dumps(row(name, planner, records)), flush=True)
+            results[planner] = summarize(records), summarize(unambiguous(records))
+            print(json.dumps(row(name, planner, records, *results[planner])), flush=True)
         if set(PLANNERS) <= set(results):
-            g, o = summarize(results["grounded"]), summarize(results["oracle"])
-            gc, oc = summarize(unambiguous(results["grounded"])), summarize(unambiguous(results["oracle"]))
+            (g, gc), (o, oc) = results["grounded"], results["oracle"]
             print(json.dumps({
                 "task_set": name, "sr_gap": round(100 * (o.SR.mean - g.SR.mean), 1),
                 "tp_gap": round(100 * (o.TP.mean - g.TP.mean), 1),

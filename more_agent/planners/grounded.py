@@ -397,7 +397,7 @@ class GroundedPlanner:
         but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
         if self.fruitless_looks >= FRUITLESS_EXPLORES:
             return None
-        rooms, path = self._task_rooms(), np.asarray(self.body.trajectory[::4], dtype=float)
+        rooms, path = self._task_rooms(), self.body.trajectory
         candidates = [
             o for o in self._graph().objects.values()
             if o.region_id in rooms and o.open is None and is_surface(o.category) and o.label not in self.looked_at
@@ -512,15 +512,15 @@ class GroundedPlanner:
             target = Area(action.arguments[0], step.region, step.frontiers)
         known = len(body.observed)
         result = run_skill(body, graph, action.name, target)
+        news = len(body.observed) > known
         if action.name == "explore":
             assert step.region is not None
             self.explored[step.region] += 1
-            self.fruitless[step.region] = 0 if len(body.observed) > known else self.fruitless[step.region] + 1
+            self.fruitless[step.region] = 0 if news else self.fruitless[step.region] + 1
         elif step.target is None and result.ok and held is not None:  # put on a floor
             self.relation[held.label] = self._on_floor_of(step.region or graph.robot.region_id)
         elif result.ok and action.name == "go_to_and_open":
             self.looked_into.add(step.target)
-        news = len(body.observed) > known
         self.fruitless_looks = 0 if news else self.fruitless_looks + (action.name == "navigate")
         if action.name == "navigate":
             self.looked_at.add(step.target)
@@ -536,12 +536,10 @@ class GroundedPlanner:
             return
         if result.reason is FailureReason.NOT_REACHABLE:
             self.out_of_reach[step.target] = len(self.body.trajectory)
-            key = (action.name, action.arguments, "not reachable")
-            limit = MAX_REACH_FAILURES
-        else:
-            key, limit = (action.name, action.arguments, result.feedback), MAX_FAILURES
-        if result.reason is FailureReason.NOT_GRASPABLE:  # furniture: trying again cannot help
-            limit = 1
+            key, limit = (action.name, action.arguments, "not reachable"), MAX_REACH_FAILURES
+        else:  # furniture cannot be picked up however often the robot tries
+            limit = 1 if result.reason is FailureReason.NOT_GRASPABLE else MAX_FAILURES
+            key = (action.name, action.arguments, result.feedback)
         self.failures[key] += 1
         if self.failures[key] < limit:
             return
@@ -564,14 +562,12 @@ def _on_floor(rel: Relation | None) -> bool:
     return rel is not None and rel[1].startswith(f"{FLOOR} ")
 
 
-def _far_corner_gap(obj: ObjectNode, path: np.ndarray) -> float:
-    """How far the corner of ``obj``'s footprint farthest from ``path`` (n x 2) is from it: a long shelf
+def _far_corner_gap(obj: ObjectNode, path: Sequence[XY]) -> float:
+    """How far the corner of ``obj``'s footprint farthest from the robot's path is from it: a long shelf
     passed at one end still has its other end to show."""
-    if not len(path):
-        return math.inf
     (x0, y0), (x1, y1) = obj.bbox.min[:2], obj.bbox.max[:2]
     corners = np.array([(x0, y0), (x0, y1), (x1, y0), (x1, y1)], dtype=float)
-    return float(np.sqrt(((corners[:, None, :] - path[None, :, :]) ** 2).sum(axis=2)).min(axis=1).max())
+    return float(_gap_to_path(corners, path).max())
 
 
 def far_frontiers(frontiers: Sequence[XY], path: Sequence[XY]) -> tuple[XY, ...]:
@@ -579,7 +575,12 @@ def far_frontiers(frontiers: Sequence[XY], path: Sequence[XY]) -> tuple[XY, ...]
     to the nearest of them, so a garden or a store is crossed instead of covered a few metres at a time."""
     if not frontiers:
         return ()
-    points = np.asarray(frontiers, dtype=float)
-    seen = np.asarray(path[::4] or [(math.inf, math.inf)], dtype=float)  # every 4th point: 0.3 m apart
-    gap = np.sqrt(((points[:, None, :] - seen[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    gap = _gap_to_path(np.asarray(frontiers, dtype=float), path)
     return tuple(f for f, d in zip(frontiers, gap) if d >= FAR_FRONTIER_SHARE * gap.max())
+
+
+def _gap_to_path(points: np.ndarray, path: Sequence[XY]) -> np.ndarray:
+    """Distance from each of ``points`` (n x 2) to the nearest point of the robot's path (every 4th
+    point, 0.3 m apart); infinite before the robot has moved."""
+    seen = np.asarray(path[::4] or [(math.inf, math.inf)], dtype=float)
+    return np.sqrt(((points[:, None, :] - seen[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
