@@ -18,17 +18,18 @@ Every step (MPC style) it rebuilds the scene graph and:
    closed container before placing inside, grasp, place, put down what the hand holds but does
    not need (on the floor, or on low furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
-   hold things, not a laptop; three in a row at most while there is a room to explore; none when only
-   furniture is missing), explores the room most likely to hold the missing furniture (BEHAVIOR-1K
-   room inventories), a room where
-   the task's items were found (they are set out together) before the others, a room whose
-   explores still reveal new objects before the rest, then the one explored least often, the
-   nearest; each explore drives to the frontiers farthest from the robot's path, of those to the
-   ones with the most unseen floor in sensor range (information gain on the robot's own occupancy
-   map). Before the search leaves the rooms of the task's items (or when their explores reveal
-   nothing new) it drives to their tables, shelves and counters it has not been near, where small
-   items show only from close by (not for missing furniture), and opens their closed containers. A room whose last two explores revealed nothing new yields to the
-   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
+   hold things, not a laptop; three in a row at most while there is a room to explore; none when
+   only furniture is missing), explores the room most likely to hold the missing furniture
+   (BEHAVIOR-1K room inventories), a room where the task's items were found (they are set out
+   together) before the others, a room whose explores still reveal new objects before the rest,
+   then the one explored least often, the nearest; each explore drives to the frontiers farthest
+   from the robot's path, of those to the ones with the most unseen floor in sensor range
+   (information gain on the robot's own occupancy map). Before the search leaves the rooms where
+   the task's items were found (or when their explores reveal nothing new) it drives to their
+   tables, shelves and counters it has not been near, where small items show only from close by,
+   and opens their closed containers (neither for missing furniture). A room whose last two
+   explores revealed nothing new yields to the other containers and closed doors; the planner
+   gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be

@@ -202,7 +202,7 @@ def test_the_robots_own_path_keeps_the_rooms_behind_a_gap_the_graph_cannot_pass(
     explore(builder, boxes, infos, [(2.0, 2.0), (3.5, 2.0), (4.6, 2.0), (6.0, 2.0)])
     alone = builder.build((6.0, 2.0))
     assert "table A" not in alone.objects  # the graph has no edge through the doorway
-    path = [(2.0, 2.0), (3.0, 2.0), (4.07, 2.0), (5.0, 2.0), (6.0, 2.0)]
+    path = [(x, 2.0) for x in np.arange(2.0, 6.0, 0.075)]  # the robot's moves: 7.5 cm each
     joined = builder.build((6.0, 2.0), path)
     assert {"table A", "table B"} <= set(joined.objects)
     assert len(_region_at(joined, True)) == 1 and joined.robot.region_id in _region_at(joined, False)
