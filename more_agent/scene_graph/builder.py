@@ -201,8 +201,11 @@ class SceneGraphBuilder:
         keep = {int(comp[node])}
         if len(path):
             dist, near = cKDTree(graph.xy).query(path, distance_upper_bound=PATH_JOIN_M)
-            for p, d, i in zip(path, dist, near):
-                if np.isfinite(d) and int(comp[i]) not in keep and line_of_sight(p, graph.xy[i:i + 1], blocked, grid)[0]:
+            hit = np.isfinite(dist)
+            path, near = path[hit], near[hit]
+            elsewhere = comp[near] != comp[node]
+            for p, i in zip(path[elsewhere], near[elsewhere]):
+                if int(comp[i]) not in keep and line_of_sight(p, graph.xy[i:i + 1], blocked, grid)[0]:
                     keep.add(int(comp[i]))
         return np.isin(comp, sorted(keep))
 
