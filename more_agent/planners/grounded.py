@@ -331,6 +331,8 @@ class GroundedPlanner:
         a = self.bound[subject]
         if a not in objects:
             return None
+        if not lit.negated and self.goal.is_floor(target) and self._floor_region(target) is None:
+            return None  # no room of the floor's type found yet: search for it first
         if lit.negated and self.goal.is_floor(target) and (self._placed_elsewhere(subject) or self._support_for(a) is None):
             return None  # the placement the goal asks for meets it; putting it down again cannot
         if not lit.negated and not self.goal.is_floor(target):

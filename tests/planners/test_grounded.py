@@ -296,3 +296,16 @@ def test_task_rooms_are_where_the_items_were_found_and_their_containers_are_open
     assert step.action.name == "go_to_and_open" and planner.seen[step.target].region_id == kitchen_room
     planner.looked_into.update(planner.seen)  # every container of the kitchen looked into
     assert planner._search(lit, None).region == far  # now the search moves on
+
+
+def test_an_item_is_not_picked_up_for_a_floor_whose_room_is_not_found_yet() -> None:
+    """"on top of the garden floor" from a house: the planner searches for the garden first; before, it
+    picked the bag up, found no garden to put it in, put it down again, and so on for 50 steps."""
+    planner = planner_in(fresh_kitchen())
+    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
+    floor = next(iter(planner.goal.floor_rooms))
+    lit = Literal("ontop", (scope, floor))
+    planner.goal.floor_rooms[floor] = "garden"
+    assert planner._floor_region(floor) is None and planner._act_for(lit, None) is None
+    planner.goal.floor_rooms[floor] = None  # any floor will do: the one the robot stands on
+    assert planner._act_for(lit, None).action.name == "go_to_and_grasp"
