@@ -15,19 +15,22 @@ Every step (MPC style) it rebuilds the scene graph and:
    floor) and calls ``done`` when all hold;
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
-   closed container before placing inside, grasp, place, put down what the hand holds but does
-   not need (on the floor, or on low furniture when the goal wants it off that floor);
+   closed container before placing inside, grasp, place (on a floor the description names only once
+   a region of that room type is known: until then it searches), put down what the hand holds but
+   does not need (on the floor, or on low furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
-   hold things, not a laptop; three in a row at most while there is a room to explore), explores
-   the room most likely to hold the missing furniture (BEHAVIOR-1K room inventories), a room where
-   the task's items were found (they are set out together) before the others, a room whose
-   explores still reveal new objects before the rest, then the one explored least often, the
-   nearest; each explore drives to the frontiers farthest from the robot's path, of those to the
-   ones with the most unseen floor in sensor range (information gain on the robot's own occupancy
-   map). Before the search leaves the rooms of the task's items (or when their explores reveal
-   nothing new) it drives to their tables, shelves and counters it has not been near, where small
-   items show only from close by. A room whose last two explores revealed nothing new yields to the
-   other containers and closed doors; the planner gives up with ``done`` when nothing is left to try.
+   hold things, not a laptop; three in a row at most while there is a room to explore; none when
+   only furniture is missing), explores the room most likely to hold the missing furniture
+   (BEHAVIOR-1K room inventories), a room where the task's items were found (they are set out
+   together) before the others, a room whose explores still reveal new objects before the rest,
+   then the one explored least often, the nearest; each explore drives to the frontiers farthest
+   from the robot's path, of those to the ones with the most unseen floor in sensor range
+   (information gain on the robot's own occupancy map). Before the search leaves the rooms where
+   the task's items were found (or when their explores reveal nothing new) it drives to their
+   tables, shelves and counters it has not been near, where small items show only from close by,
+   and opens their closed containers (neither for missing furniture). A room whose last two
+   explores revealed nothing new yields to the other containers and closed doors; the planner
+   gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way is not repeated: its target is dropped from the bindings
 (another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
@@ -128,6 +131,8 @@ class GroundedPlanner:
         self.bound: dict[str, str] = {}
         self.seen: dict[str, ObjectNode] = {}
         """Label -> the object as last observed (objects of rooms now out of reach included)."""
+        self.found_in: dict[str, str | None] = {}
+        """Label -> the region the object was first observed in."""
         self.relation: dict[str, Relation | None] = {}
         """Label -> where it rests as last observed or placed."""
         self.looked_into: set[str] = set()
@@ -168,6 +173,7 @@ class GroundedPlanner:
         rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
         for obj in graph.objects.values():
             self.seen[obj.label] = obj
+            self.found_in.setdefault(obj.label, obj.region_id)
             if obj.open:
                 self.looked_into.add(obj.label)
             if obj.held:
@@ -326,6 +332,8 @@ class GroundedPlanner:
         a = self.bound[subject]
         if a not in objects:
             return None
+        if not lit.negated and self.goal.is_floor(target) and self._floor_region(target) is None:
+            return None  # no room of the floor's type found yet: search for it first
         if lit.negated and self.goal.is_floor(target) and (self._placed_elsewhere(subject) or self._support_for(a) is None):
             return None  # the placement the goal asks for meets it; putting it down again cannot
         if not lit.negated and not self.goal.is_floor(target):
@@ -366,18 +374,23 @@ class GroundedPlanner:
         missing = [s for s in lit.args if s != self.goal.robot and not self.goal.is_floor(s) and self._label(s) is None]
         note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
         here = graph.robot.region_id
+        items = not missing or any(not self._is_furniture(s) for s in missing)
         closed = sorted(
-            (o for o in graph.objects.values() if o.open is False and can_hold_things(o.category)
+            (o for o in graph.objects.values() if items and o.open is False and can_hold_things(o.category)
              and o.label not in self.looked_into and o.label not in self.dropped),
             key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
         )
         region = self._room_to_explore(missing)
         if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
             return self._open_to_look(closed[0].label, held, note)
-        if region is None or self._stale(region) or region not in self._task_rooms():
+        task_rooms = self._task_rooms()
+        if items and (region is None or self._stale(region) or region not in task_rooms):
             furniture = self._furniture_to_look_at()
             if furniture is not None:
                 return self._object_step("navigate", furniture, note)
+            in_task_rooms = [o for o in closed if o.region_id in task_rooms]
+            if in_task_rooms:
+                return self._open_to_look(in_task_rooms[0].label, held, note)
         if region is not None and not self._stale(region):
             return self._explore_step(region, note)
         if closed:
@@ -390,6 +403,13 @@ class GroundedPlanner:
             return self._explore_step(region, note)
         why = f"{note}: nothing left to explore or open"
         return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+
+    def _is_furniture(self, scope: str) -> bool:
+        """Whether ``scope`` is furniture: the goal does not move it and every category that counts as it
+        is furniture. A missing table is in no cabinet and shows from afar, so the search neither opens
+        containers nor drives along shelves for it."""
+        cats = self.goal.categories.get(scope, frozenset())
+        return scope not in self.goal.moved and bool(cats) and all(is_furniture(c) for c in cats)
 
     def _furniture_to_look_at(self) -> str | None:
         """The nearest furniture things are put on (tables, shelves, counters: ``sim.clutter.is_surface``)
@@ -432,11 +452,12 @@ class GroundedPlanner:
         return min(open_regions, key=score) if open_regions else None
 
     def _task_rooms(self) -> set[str]:
-        """Regions of the objects found so far that the goal moves: a task's items are set out together
-        (a store's groceries, a kitchen's food), so its other items are likeliest there. Furniture a goal
-        only names as a target (any cabinet the plates may go in) tells nothing of where they are."""
+        """Regions where the objects the goal moves were found (not where the robot put them): a task's
+        items are set out together (a store's groceries, a kitchen's food), so its other items are
+        likeliest there. Furniture a goal only names as a target (any cabinet the plates may go in)
+        tells nothing of where they are."""
         moved = {lit.args[0] for lit in self.literals if lit.predicate != "open"}
-        return {self.seen[self.bound[s]].region_id for s in moved if s in self.bound} - {None}
+        return {self.found_in[self.bound[s]] for s in moved if s in self.bound} - {None}
 
     def _stale(self, region: str) -> bool:
         """Whether the region's last explores revealed no object not seen before."""

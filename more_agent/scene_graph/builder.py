@@ -23,7 +23,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from scipy.spatial import cKDTree
 
-from more_agent.mapping import MappingConfig, NavGraph, RegionGraph, VoxelMap, line_of_sight, region_graph
+from more_agent.mapping import OCCUPIED, MappingConfig, NavGraph, RegionGraph, VoxelMap, line_of_sight, region_graph
 from more_agent.scene_graph.model import (
     Box3D,
     InstanceInfo,
@@ -41,6 +41,9 @@ from more_agent.sim.scene import FREE_SPACE_CLASSES
 
 STRUCTURE_CATEGORIES = ("wall", "window", "door")
 """Classes that block line of sight for object assignment."""
+
+PATH_JOIN_M = 0.3
+"""A graph component whose node a point of the robot's path sees within this distance is reachable (``build``)."""
 
 GLIMPSE_MAX_PIXELS = 400
 """Instances covering at most this many pixels of a frame also get a box from those pixels (``_glimpse``)."""
@@ -119,8 +122,14 @@ class SceneGraphBuilder:
         self._room_labels.update(labels)
 
     # ---------------------------------------------------------------- per step
-    def build(self, robot_xy: Sequence[float]) -> SceneGraph:
-        """The scene graph of everything observed so far, reduced to the robot's component."""
+    def build(self, robot_xy: Sequence[float], path_xy: Sequence[Sequence[float]] = ()) -> SceneGraph:
+        """The scene graph of everything observed so far, reduced to the robot's component.
+
+        ``path_xy`` (the robot's path so far, oldest first) joins the components the robot can drive back
+        to: it stood in them, and its path from there crosses nothing seen since (``_retraceable``). A
+        pocket the graph cannot enter (a gap narrower than the graph's clearance that the robot
+        squeezed through) then keeps the rest of the map instead of being all the robot knows.
+        """
         grid = self.voxels.grid
         robot = np.asarray(robot_xy[:2], dtype=float)
         occ = self.voxels.occupancy()
@@ -139,7 +148,7 @@ class SceneGraphBuilder:
         rg = region_graph(occ, grid, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
                           blocked=blocked, config=self.config)
         region_ids = self._stable_ids(rg.graph, rg.labels)
-        keep = self._robot_component(rg.graph, robot, blocked, grid)
+        keep = self._robot_component(rg.graph, robot, blocked, grid, self._retraceable(path_xy, occ, grid))
         frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
         return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, grid)
 
@@ -182,13 +191,35 @@ class SceneGraphBuilder:
         seen = line_of_sight(p, graph.xy[order], blocked, grid)
         return int(order[np.argmax(seen)] if seen.any() else order[0])
 
-    def _robot_component(self, graph: NavGraph, robot: np.ndarray, blocked, grid: Grid) -> np.ndarray:
-        """Node mask of the (door-uncut) graph component the robot stands in."""
+    def _robot_component(self, graph: NavGraph, robot: np.ndarray, blocked, grid: Grid, path: np.ndarray) -> np.ndarray:
+        """Node mask of the (door-uncut) graph component the robot stands in, joined with the components
+        whose nodes ``path`` points see within ``PATH_JOIN_M``."""
         node = self._nearest_visible(graph, np.arange(graph.n_nodes), robot, blocked, grid)
         if node < 0:
             return np.zeros(graph.n_nodes, dtype=bool)
         comp = graph.components()
-        return comp == comp[node]
+        keep = {int(comp[node])}
+        if len(path):
+            dist, near = cKDTree(graph.xy).query(path, distance_upper_bound=PATH_JOIN_M)
+            hit = np.isfinite(dist)
+            path, near = path[hit], near[hit]
+            elsewhere = comp[near] != comp[node]
+            for p, i in zip(path[elsewhere], near[elsewhere]):
+                if int(comp[i]) not in keep and line_of_sight(p, graph.xy[i:i + 1], blocked, grid)[0]:
+                    keep.add(int(comp[i]))
+        return np.isin(comp, sorted(keep))
+
+    @staticmethod
+    def _retraceable(path_xy: Sequence[Sequence[float]], occ: np.ndarray, grid: Grid) -> np.ndarray:
+        """The points (n x 2) of the robot's path after the last one on a cell now occupied (a door
+        closed, an item put down): the robot can drive back along them."""
+        path = np.asarray(path_xy, dtype=float).reshape(-1, 2)
+        cells = grid.cell_of(path)
+        on_map = (cells >= 0).all(axis=1) & (cells < occ.shape).all(axis=1)
+        occupied = np.zeros(len(path), dtype=bool)
+        occupied[on_map] = occ[cells[on_map, 0], cells[on_map, 1]] == OCCUPIED
+        start = int(np.flatnonzero(occupied)[-1]) + 1 if occupied.any() else 0
+        return path[start:]
 
     def _attach(self, graph: NavGraph, labels: np.ndarray, points: np.ndarray, blocked, grid: Grid) -> np.ndarray:
         """Node index (labelled nodes only, -1 if none) each point belongs to."""

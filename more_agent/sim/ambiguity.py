@@ -20,14 +20,15 @@ from more_agent.sim.instantiate import TaskInstance
 from more_agent.sim.tasks import atoms, scope_synset
 
 _SCOPE_WORD = re.compile(r"\$([\w.]+?\.n\.\d+_\d+)")
-_INSTANCE_LABEL = re.compile(r"\S+ [A-Z]+")
-"""An instance label ('apple A'); a bare category ('every mail') names no instance."""
+_INSTANCE_LABEL = re.compile(r"\S+ [A-Z]+|the .+ floor")
+"""An instance label ('apple A') or a floor's ('the garden floor'); a bare category ('every mail')
+names no instance."""
 
 
 def described_scopes(instance: TaskInstance) -> set[str]:
     """Scopes whose instance the description names: the paper's ``$scope`` words, or the scopes whose
-    instance label a description generated from the goal contains (a quantified scope is named by its
-    category only: 'every mail' binds no instance)."""
+    instance label a description generated from the goal contains ('the garden floor' included; a
+    quantified scope is named by its category only: 'every mail' binds no instance)."""
     text = instance.definition.paper_description
     if text is not None:
         return set(_SCOPE_WORD.findall(text)) & set(instance.scope)

@@ -253,3 +253,59 @@ def test_an_object_that_must_leave_the_floor_is_not_picked_up_to_be_put_down_aga
     planner.bound["bag"], planner.bound["counter"] = "paper_bag A", "countertop A"
     planner.literals = [Literal("ontop", ("bag", floor), True), Literal("ontop", ("bag", "counter"))]
     assert planner._act_for(planner.literals[0], None) is None
+
+
+def with_far_room(planner: GroundedPlanner) -> str:
+    """Add an unexplored region far from the kitchen to the planner's graph; its id."""
+    graph = planner._graph()
+    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
+    planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
+    planner.names[other.id] = "garden_0"
+    return other.id
+
+
+def test_missing_furniture_is_not_looked_for_in_containers() -> None:
+    """A breakfast table is in no cabinet: when only furniture is missing the search opens nothing
+    (putting_out_condiments seed 1 opened twenty kitchen cabinets for one). The kitchen has no bed."""
+    planner = planner_in(fresh_kitchen())
+    table = "bed.n.01_1"
+    planner.goal.categories[table] = frozenset({"bed"})
+    unseen = next(lit.args[0] for lit in planner.literals if planner._label(lit.args[0]) is None)
+    assert planner._is_furniture(table) and not planner._is_furniture(unseen)
+    item = planner._search(Literal("ontop", (unseen, table)), None)
+    assert item.action.name == "go_to_and_open"  # an item may be in the closed cabinets of the room
+    step = planner._search(Literal("ontop", ("cup__of__yogurt.n.01_1", table)), None)  # the yogurt is in view
+    assert step.action.name == "explore"
+
+
+def test_task_rooms_are_where_the_items_were_found_and_their_containers_are_opened_before_leaving() -> None:
+    """Items put in another room leave the room they were found in a task room: the other items are
+    likeliest there (the peanut butter of putting_out_condiments in a kitchen cabinet, after the
+    vinegar went to a table three rooms away)."""
+    planner = planner_in(fresh_kitchen())
+    far = with_far_room(planner)
+    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
+    kitchen_room = planner.seen["cup_of_yogurt A"].region_id
+    planner.seen["cup_of_yogurt A"] = planner.seen["cup_of_yogurt A"].model_copy(update={"region_id": far})
+    assert planner._task_rooms() == {kitchen_room}  # found there, whatever room it was carried to
+    planner.fruitless[kitchen_room] = FRUITLESS_EXPLORES  # the kitchen's explores show nothing new
+    planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
+    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # the room's containers had their turn in a row
+    lit = next(lit for lit in planner.literals if planner._label(lit.args[0]) is None)
+    step = planner._search(lit, None)
+    assert step.action.name == "go_to_and_open" and planner.seen[step.target].region_id == kitchen_room
+    planner.looked_into.update(planner.seen)  # every container of the kitchen looked into
+    assert planner._search(lit, None).region == far  # now the search moves on
+
+
+def test_an_item_is_not_picked_up_for_a_floor_whose_room_is_not_found_yet() -> None:
+    """"on top of the garden floor" from a house: the planner searches for the garden first; before, it
+    picked the bag up, found no garden to put it in, put it down again, and so on for 50 steps."""
+    planner = planner_in(fresh_kitchen())
+    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
+    floor = next(iter(planner.goal.floor_rooms))
+    lit = Literal("ontop", (scope, floor))
+    planner.goal.floor_rooms[floor] = "garden"
+    assert planner._floor_region(floor) is None and planner._act_for(lit, None) is None
+    planner.goal.floor_rooms[floor] = None  # any floor will do: the one the robot stands on
+    assert planner._act_for(lit, None).action.name == "go_to_and_grasp"

@@ -8,7 +8,7 @@ import pytest
 
 from more_agent.mapping import region_graph
 from more_agent.scene_graph import InstanceInfo, SceneGraph, load_scene_graph, to_networkx
-from tests.scene_graph.boxworld import Box, camera_pose, intrinsics, render
+from tests.scene_graph.boxworld import Box, camera_pose, intrinsics, render, walls_x, walls_y
 from tests.scene_graph.scenes import SIZE, explore, house_and_garden, new_builder, two_rooms
 
 ROOMS = [(2.0, 2.0), (3.0, 2.0), (5.0, 2.0), (6.0, 2.0)]
@@ -182,3 +182,29 @@ def test_a_small_item_sharing_its_voxels_with_its_support_stays_in_the_graph() -
     held = {**infos, 4: InstanceInfo(label="apple A", category="apple", held=True)}
     explore(builder, boxes, held, [(1.4, 2.0)], n_yaw=1)
     assert builder.build((1.4, 2.0)).objects["apple A"].region_id is None
+
+
+def _rooms_behind_a_slit() -> tuple[list[Box], dict[int, InstanceInfo]]:
+    """Two rooms (x in [0, 4] and [4.15, 8.15]) joined by a doorway (y 1.9..2.1) narrower on the map
+    than the graph's clearance, with a table in each."""
+    boxes = [Box((-0.2, -0.2, -0.05), (8.4, 4.2, 0.0), "floor")]
+    boxes += walls_y(-0.15, -0.15, 8.3) + walls_y(4.0, -0.15, 8.3)
+    boxes += walls_x(-0.15, -0.15, 4.15) + walls_x(8.15, -0.15, 4.15) + walls_x(4.0, 0.0, 4.0, openings=[(1.9, 2.1)])
+    boxes += [Box((4.0, 1.9, 2.1), (4.15, 2.1, 2.6), "door", 1),
+              Box((1.0, 2.8, 0), (1.8, 3.6, 0.75), "table", 2), Box((6.5, 3.0, 0), (7.3, 3.7, 0.75), "table", 3)]
+    return boxes, {1: InstanceInfo(label="door A", category="door", open=True),
+                   2: InstanceInfo(label="table A", category="table"), 3: InstanceInfo(label="table B", category="table")}
+
+
+def test_the_robots_own_path_keeps_the_rooms_behind_a_gap_the_graph_cannot_pass() -> None:
+    boxes, infos = _rooms_behind_a_slit()
+    builder = new_builder()
+    explore(builder, boxes, infos, [(2.0, 2.0), (3.5, 2.0), (4.6, 2.0), (6.0, 2.0)])
+    alone = builder.build((6.0, 2.0))
+    assert "table A" not in alone.objects  # the graph has no edge through the doorway
+    path = [(x, 2.0) for x in np.arange(2.0, 6.0, 0.075)]  # the robot's moves: 7.5 cm each
+    joined = builder.build((6.0, 2.0), path)
+    assert {"table A", "table B"} <= set(joined.objects)
+    assert len(_region_at(joined, True)) == 1 and joined.robot.region_id in _region_at(joined, False)
+    # A path that crosses a cell occupied now (as through a door closed since) joins nothing.
+    assert "table A" not in builder.build((6.0, 2.0), [(2.0, 2.0), (4.02, 0.5), (6.0, 2.0)]).objects

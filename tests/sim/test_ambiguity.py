@@ -35,3 +35,13 @@ def test_a_quantified_goal_scope_is_not_ambiguous() -> None:
     # putting_dishes_away_after_cleaning: every plate in some cabinet, every cabinet closed.
     inst = instantiate("putting_dishes_away_after_cleaning", seed=0, start="task-room", distractors=False)
     assert not any(s.startswith("cabinet") for s in ambiguous_scopes(inst))
+
+
+def test_a_generated_description_names_the_floors_it_mentions() -> None:
+    # "put every bag of rubbish on top of the garden floor": the garden's floor, not the living room's
+    # the bags lie on (the planner took any floor for it, and called done at its first step).
+    inst = instantiate("taking_trash_outside", seed=0, start="task-room", distractors=False)
+    assert inst.definition.paper_description is None and "the garden floor" in inst.description
+    floors = {s for s in inst.scope if s.startswith("floor.")}
+    assert {s for s in floors if inst.label(s) == "the garden floor"} == floors & described_scopes(inst)
+    assert len(floors) == 2 and len(floors & described_scopes(inst)) == 1

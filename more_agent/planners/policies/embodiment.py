@@ -137,8 +137,9 @@ class Embodiment:
         return obj.relation, parent.label if parent.kind != "floor" else None
 
     def build(self) -> SceneGraph:
-        """The scene graph of everything sensed so far, from the robot's position."""
-        return self.builder.build(self.xy)
+        """The scene graph of everything sensed so far, from the robot's position (joined with the
+        components its path can drive back to)."""
+        return self.builder.build(self.xy, self.trajectory)
 
     def act(self, kind: str, target: str = "") -> ActionResult:
         """One magic action of the env (a world action of the skill table: ``navigate_to``, ``grasp``,
