@@ -374,18 +374,18 @@ class GroundedPlanner:
         missing = [s for s in lit.args if s != self.goal.robot and not self.goal.is_floor(s) and self._label(s) is None]
         note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
         here = graph.robot.region_id
-        items = not missing or any(not self._is_furniture(s) for s in missing)
+        items = not missing or any(not self._is_furniture_scope(s) for s in missing)
         closed = sorted(
-            (o for o in graph.objects.values() if items and o.open is False and can_hold_things(o.category)
+            (o for o in graph.objects.values() if o.open is False and can_hold_things(o.category)
              and o.label not in self.looked_into and o.label not in self.dropped),
             key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
-        )
-        region = self._room_to_explore(missing)
+        ) if items else []
+        task_rooms = self._task_rooms()
+        region = self._room_to_explore(missing, task_rooms)
         if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
             return self._open_to_look(closed[0].label, held, note)
-        task_rooms = self._task_rooms()
         if items and (region is None or self._stale(region) or region not in task_rooms):
-            furniture = self._furniture_to_look_at()
+            furniture = self._furniture_to_look_at(task_rooms)
             if furniture is not None:
                 return self._object_step("navigate", furniture, note)
             in_task_rooms = [o for o in closed if o.region_id in task_rooms]
@@ -404,20 +404,20 @@ class GroundedPlanner:
         why = f"{note}: nothing left to explore or open"
         return _Step(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
-    def _is_furniture(self, scope: str) -> bool:
+    def _is_furniture_scope(self, scope: str) -> bool:
         """Whether ``scope`` is furniture: the goal does not move it and every category that counts as it
         is furniture. A missing table is in no cabinet and shows from afar, so the search neither opens
         containers nor drives along shelves for it."""
         cats = self.goal.categories.get(scope, frozenset())
         return scope not in self.goal.moved and bool(cats) and all(is_furniture(c) for c in cats)
 
-    def _furniture_to_look_at(self) -> str | None:
+    def _furniture_to_look_at(self, rooms: set[str]) -> str | None:
         """The nearest furniture things are put on (tables, shelves, counters: ``sim.clutter.is_surface``)
-        of the task's rooms the robot has not been near (``LOOK_AT_M``): explore() clears a store's floor,
-        but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
+        of the task's ``rooms`` the robot has not been near (``LOOK_AT_M``): explore() clears a store's
+        floor, but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
         if self.fruitless_looks >= FRUITLESS_EXPLORES:
             return None
-        rooms, path = self._task_rooms(), self.body.trajectory
+        path = self.body.trajectory
         candidates = [
             o for o in self._graph().objects.values()
             if o.region_id in rooms and o.open is None and is_surface(o.category) and o.label not in self.looked_at
@@ -431,15 +431,14 @@ class GroundedPlanner:
             return self._put_down(held)
         return self._object_step("go_to_and_open", label, note)
 
-    def _room_to_explore(self, missing: list[str]) -> str | None:
+    def _room_to_explore(self, missing: list[str], task_rooms: set[str]) -> str | None:
         """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
         new last; then the room most likely to hold the missing furniture; then the rooms of the task's
-        items found so far (``_task_rooms``); then a room whose explores still reveal new objects before
+        items found so far (``task_rooms``, from ``_task_rooms``); then a room whose explores still reveal new objects before
         one not explored yet (a garden or a store is searched through, not left after a few metres);
         then the least explored, the nearest."""
         graph = self._graph()
         cats = [c for s in missing for c in self.goal.categories.get(s, ()) if is_furniture(c)]
-        task_rooms = self._task_rooms()
 
         def score(rid: str) -> tuple[bool, float, bool, bool, int, float, str]:
             kind = self.room_types.get(rid)

@@ -12,7 +12,11 @@ The goal is read as its author meant it (:func:`intended_goal`): eight bddl acti
 legal_document.n.01) (inside ?legal_document.n.01_1 ?recycling_bin.n.01_1))``, which bddl checks as
 "legal_document.n.01_1 is in the bin", one document no reader can tell from the others ("throw all
 legal documents in the recycling bin"). Read as written by intent, every document goes in the bin,
-which satisfies the goal whichever one bddl means.
+which satisfies the goal whichever one bddl means. Not so where the typo sits in an implication:
+buying_groceries' ``(forall (?sack.n.01 ...) (imply (inside ?carton__of__milk.n.01_1 ?sack.n.01_1)
+(not (inside ?banana.n.02_1 ?sack.n.01))))`` means "milk and banana not in one bag", which the
+intended reading keeps, but bddl checks "the milk is not in sack_1", which no reader of "one bag
+... another bag" can tell from sack_2: a coin flip (seed 2 of the ceiling benchmark lost it).
 """
 
 from __future__ import annotations
@@ -119,4 +123,3 @@ def _terms(parsed: Any) -> set[str]:
 
 def _renamed(parsed: Any, rename: Callable[[str], str]) -> Any:
     return rename(parsed) if isinstance(parsed, str) else [_renamed(p, rename) for p in parsed]
-

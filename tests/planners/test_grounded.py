@@ -229,9 +229,9 @@ def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
     other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
     planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
     planner.explored[room], planner.fruitless[room] = 5, 1  # explored often, the last one without news
-    assert planner._room_to_explore([]) == other.id  # nothing of the task found yet: the fresh room
+    assert planner._room_to_explore([], planner._task_rooms()) == other.id  # nothing of the task found yet: the fresh room
     assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
-    assert planner._room_to_explore([]) == room
+    assert planner._room_to_explore([], planner._task_rooms()) == room
 
 
 def test_when_only_closing_is_left_the_planner_closes() -> None:
@@ -271,7 +271,7 @@ def test_missing_furniture_is_not_looked_for_in_containers() -> None:
     table = "bed.n.01_1"
     planner.goal.categories[table] = frozenset({"bed"})
     unseen = next(lit.args[0] for lit in planner.literals if planner._label(lit.args[0]) is None)
-    assert planner._is_furniture(table) and not planner._is_furniture(unseen)
+    assert planner._is_furniture_scope(table) and not planner._is_furniture_scope(unseen)
     item = planner._search(Literal("ontop", (unseen, table)), None)
     assert item.action.name == "go_to_and_open"  # an item may be in the closed cabinets of the room
     step = planner._search(Literal("ontop", ("cup__of__yogurt.n.01_1", table)), None)  # the yogurt is in view
