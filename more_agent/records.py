@@ -102,6 +102,9 @@ class EpisodeRecord(BaseModel):
     planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'.")
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
     start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
+    distractors: bool | None = Field(
+        default=None, description="Whether the world held the scene's own small objects; None in records written before it was kept."
+    )
     description: str = Field(default="", description="Language description the planner received.")
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
     all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
@@ -136,7 +139,7 @@ class EpisodeRecord(BaseModel):
         """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
         return cls(
             task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, start=spec.start,
-            **fields,
+            distractors=spec.distractors, **fields,
         )
 
 

@@ -11,7 +11,7 @@ import more_agent
 ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
-    ("__init__", "errors", "redaction", "interrupts", "records", "skills"),
+    ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills"),
     ("sim",),
     ("mapping",),
     ("scene_graph",),

@@ -1,9 +1,18 @@
-"""Shared CLI plumbing: exit statuses, clean errors, safe printing of untrusted text, a rich console.
+"""Shared CLI plumbing: the exit-status table, clean errors, safe printing of untrusted text, a console.
 
-Exit statuses of every command: 0 done; 1 an episode or the program itself failed (a bug, an LLM
-that refused the request); 2 bad input (one line on stderr, nothing written lost); 75 the run ended
-but some episodes hit transient errors (LLM transport, worker deaths): re-run them with
-``--resume --retry-errors``; 130 interrupted by Ctrl-C.
+The exit statuses of every command (the contract of docs/evaluation.md, "Exit status"), decided in
+two places only: :func:`episodes_exit_status` for what episodes ended in, :func:`error_exit_status`
+for what a command raised.
+
+====  ==========================================================================================
+0     every episode ran, whatever it scored
+1     a system error in some episode (code raised, the LLM refused the request or the key, a server
+      sent a body over the cap), or in the program itself
+2     bad input: one line on stderr, before any work where it can be known then; nothing written lost
+75    transient (``EX_TEMPFAIL``): episodes hit LLM timeouts, 5xx, a locked cache, a dead worker, or
+      the disk filled up; run again (``eval --resume --retry-errors``)
+130   interrupted by Ctrl-C (SIGINT); 143 terminated by SIGTERM
+====  ==========================================================================================
 """
 
 from __future__ import annotations
@@ -11,7 +20,7 @@ from __future__ import annotations
 import functools
 import logging
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Annotated, TypeVar
 
@@ -20,18 +29,27 @@ from rich.console import Console
 from rich.text import Text
 
 from more_agent.errors import UserError, check_writable_dir
-from more_agent.interrupts import interrupted, sigint_remembered
+from more_agent.interrupts import interrupted, signal_exit_status, signals_remembered
 from more_agent.llm.limits import MAX_LOG_CHARS, clip
-from more_agent.redaction import redact
+from more_agent.records import EpisodeRecord
+from more_agent.redaction import for_terminal
+from more_agent.safe_files import DISK_FULL_ERRNOS, path_error
 
 console = Console()
 err_console = Console(stderr=True)
 
+EXIT_OK = 0
 EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_RETRYABLE = 75
 """``EX_TEMPFAIL`` of sysexits.h: a temporary failure; running again may succeed."""
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
+
+MAX_SEED = 2**32 - 1
+"""Largest seed (numpy's seeds are 32-bit words; a 240-digit seed would only make a too-long folder name)."""
+MAX_SEEDS = 10_000
+"""Largest ``eval --seeds`` (10,000 seeds per task is already weeks of episodes)."""
 
 F = TypeVar("F", bound=Callable[..., object])
 
@@ -51,7 +69,7 @@ class _SafeStderrHandler(logging.Handler):
 
     def emit(self, record: logging.LogRecord) -> None:
         try:
-            sys.stderr.write(f"{record.levelname.lower()}: {clip(redact(record.getMessage()), MAX_LOG_CHARS)}\n")
+            sys.stderr.write(f"{record.levelname.lower()}: {clip(for_terminal(record.getMessage()), MAX_LOG_CHARS)}\n")
         except Exception:  # noqa: BLE001 - logging must never take the program down
             self.handleError(record)
 
@@ -66,31 +84,66 @@ def _install_log_handler() -> None:
 
 
 def print_error(message: str) -> None:
-    """One red ``error:`` line on stderr; the message is printed as plain text (never as markup), redacted."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", redact(message)), highlight=False, soft_wrap=True)
+    """One red ``error:`` line on stderr; the message is printed as plain text (never as markup),
+    redacted, without escape sequences."""
+    err_console.print(Text.assemble(("error:", "bold red"), " ", for_terminal(message)), highlight=False, soft_wrap=True)
+
+
+def episodes_exit_status(records: Iterable[EpisodeRecord]) -> int:
+    """The exit status for what episodes ended in: 1 if one ended in a system error that is not
+    transient, else 75 if one ended in a transient one, else 0 (whatever they scored)."""
+    from more_agent.eval.episode import ended_abnormally
+
+    abnormal = [r for r in records if ended_abnormally(r)]
+    if any(not r.retryable for r in abnormal):
+        return EXIT_FAILED
+    return EXIT_RETRYABLE if abnormal else EXIT_OK
+
+
+def error_exit_status(error: UserError | OSError | RecursionError) -> tuple[int, str]:
+    """The exit status and the one-line message for what a command raised (any other exception is a
+    bug, and keeps its traceback)."""
+    if isinstance(error, UserError):
+        return EXIT_BAD_INPUT, str(error)
+    if isinstance(error, OSError):
+        bad_path = path_error(error)
+        if bad_path is not None:
+            return EXIT_BAD_INPUT, str(bad_path)
+        where = f" ({error.filename})" if error.filename else ""
+        if error.errno in DISK_FULL_ERRNOS:
+            return EXIT_RETRYABLE, f"{error.strerror}{where}: free some space and run it again"
+        return EXIT_FAILED, f"{error.strerror or error}{where}"
+    return EXIT_BAD_INPUT, "the input is nested too deeply to read"  # a RecursionError
 
 
 def user_errors_exit_2(fn: F) -> F:
-    """Decorate a command: a UserError prints one red line and exits 2; Ctrl-C, even a swallowed one, exits 130."""
+    """Decorate a command: what it raises ends in one line and the status of :func:`error_exit_status`
+    (a UserError: 2); Ctrl-C exits 130 and SIGTERM 143, even when native code swallowed the signal."""
 
     @functools.wraps(fn)
     def wrapper(*args: object, **kwargs: object) -> object:
         _install_log_handler()
-        with sigint_remembered():
+        with signals_remembered():
             try:
                 result = fn(*args, **kwargs)
-            except UserError as e:
-                print_error(str(e))
-                raise typer.Exit(code=EXIT_BAD_INPUT) from None
             except KeyboardInterrupt:
-                err_console.print("interrupted", style="yellow", highlight=False)
-                raise typer.Exit(code=EXIT_INTERRUPTED) from None
+                return _interrupted()
+            except (UserError, OSError, RecursionError) as e:
+                if interrupted():
+                    return _interrupted()
+                code, message = error_exit_status(e)
+                print_error(message)
+                raise typer.Exit(code=code) from None
             if interrupted():
-                err_console.print("interrupted", style="yellow", highlight=False)
-                raise typer.Exit(code=EXIT_INTERRUPTED)
+                return _interrupted()
         return result
 
     return wrapper  # type: ignore[return-value]
+
+
+def _interrupted() -> None:
+    err_console.print("interrupted", style="yellow", highlight=False)
+    raise typer.Exit(code=signal_exit_status())
 
 
 def check_output_file(path: Path) -> None:

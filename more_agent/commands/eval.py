@@ -2,13 +2,26 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from more_agent.commands._common import EXIT_RETRYABLE, DistractorsOption, StartOption, err_console, user_errors_exit_2
+from more_agent.commands._common import (
+    EXIT_FAILED,
+    EXIT_RETRYABLE,
+    MAX_SEEDS,
+    DistractorsOption,
+    StartOption,
+    err_console,
+    episodes_exit_status,
+    user_errors_exit_2,
+)
 from more_agent.errors import UserError
+
+RAY_ADDRESS = re.compile(r"local|auto|(ray://)?[A-Za-z0-9.\-\[\]:]+:\d{1,5}")
+"""What ``--ray-address`` may be: 'local', 'auto', or HOST:PORT with an optional ray:// prefix."""
 
 
 @user_errors_exit_2
@@ -17,7 +30,7 @@ def eval_(
     planner: Annotated[str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr, bumble, bumble-filter.")],
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
-    seeds: Annotated[int, typer.Option(min=1, help="Seeds per task: 0 .. N-1.")] = 1,
+    seeds: Annotated[int, typer.Option(min=1, max=MAX_SEEDS, help="Seeds per task: 0 .. N-1.")] = 1,
     scene: Annotated[str | None, typer.Option(
         help="Scene for every task (default: drawn per episode among each task's suitable scenes)."
     )] = None,
@@ -46,7 +59,9 @@ def eval_(
 ) -> None:
     """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl.
 
-    Exit status 75 when episodes ended with retryable errors (re-run them with --resume --retry-errors).
+    Exit status 0 when every episode of the run ran (whatever it scored), 1 when some ended in a
+    system error, 75 when the only such errors are transient (re-run them with --resume
+    --retry-errors), 2 for bad input.
     """
     from more_agent import __version__
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
@@ -62,6 +77,8 @@ def eval_(
     if viewer:
         episode_fn = VIEWER_EPISODE_FN
     check_run_dir(out)
+    if ray_address is not None and not RAY_ADDRESS.fullmatch(ray_address):
+        raise UserError(f"--ray-address {ray_address!r} is not 'local', 'auto' or HOST:PORT (e.g. ray://10.0.0.5:10001)")
     if llm is not None:
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
@@ -97,15 +114,23 @@ def eval_(
     paths = write_reports(sourced, out, title=f"{planner} on {tasks}")
     typer.echo(table_i_markdown([s.record for s in sourced]))
     errors = sum(r.error is not None for r in records)
-    retryable = sum(r.retryable for r in records)
     if errors:
         err_console.print(f"{errors} episode(s) ended with an error; see {out / 'report.html'}",
                           style="yellow", highlight=False, markup=False)
     err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False)
-    if retryable:
+    status = episodes_exit_status(records)
+    if status == EXIT_FAILED:
         err_console.print(
-            f"{retryable} episode(s) hit a transient error (LLM transport, worker death) and are not results: "
-            f"re-run them with: more-agent eval ... --out {out} --resume --retry-errors (exit status {EXIT_RETRYABLE})",
+            "some episodes ended in a system error (code raised, the LLM refused the request or the key); "
+            f"see their 'error' in {out / 'episodes.jsonl'} (exit status {EXIT_FAILED})",
             style="yellow", highlight=False, markup=False,
         )
-        raise typer.Exit(code=EXIT_RETRYABLE)
+    elif status == EXIT_RETRYABLE:
+        err_console.print(
+            f"{sum(r.retryable for r in records)} episode(s) hit a transient error (LLM transport, worker death) and "
+            f"are not results: re-run them with: more-agent eval ... --out {out} --resume --retry-errors "
+            f"(exit status {EXIT_RETRYABLE})",
+            style="yellow", highlight=False, markup=False,
+        )
+    if status:
+        raise typer.Exit(code=status)

@@ -1,7 +1,10 @@
 """``more-agent run TASK``: run one episode and write ``DIR/episode.json`` and ``DIR/map.png``.
 
 Bad input (unknown task, scene or planner; a task that cannot be instantiated in the asked scene)
-ends with one error line and exit status 2, never a traceback.
+ends with one error line and exit status 2, never a traceback. The output folder is locked as
+``eval`` locks its run folder (a second ``run`` into it is refused); a folder holding a finished
+episode of another spec is refused, one holding an earlier run of the same episode (or an unfinished
+one) is cleaned of that episode's files first.
 """
 
 from __future__ import annotations
@@ -15,15 +18,16 @@ from rich.table import Table
 from rich.text import Text
 
 from more_agent.commands._common import (
-    EXIT_FAILED,
-    EXIT_RETRYABLE,
+    MAX_SEED,
     DistractorsOption,
     StartOption,
     console,
+    episodes_exit_status,
     user_errors_exit_2,
 )
 from more_agent.errors import check_writable_dir
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.redaction import for_terminal
 
 NO_LLM_MESSAGE = (
     "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
@@ -57,17 +61,17 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     table.add_column(style="bold")
     table.add_column()
     verdict = Text("success", style="green") if record.success else Text("failure", style="red")
-    table.add_row("episode", Text(f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}"))
+    table.add_row("episode", Text(for_terminal(f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}")))
     table.add_row("result", Text.assemble(verdict, f"; goals met: {record.all_goals_met}; done called: {record.done_called}"))
     met = sum(c.satisfied for c in record.goal_conditions)
     table.add_row("progress", f"{record.task_progress:.2f} ({met}/{len(record.goal_conditions)} goal conditions)")
     table.add_row("steps", f"{record.high_level_steps} high-level, {record.low_level_steps} low-level")
     table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
     if record.error:
-        table.add_row("why", Text(record.error))  # may quote a server: never markup
+        table.add_row("why", Text(for_terminal(record.error)))  # may quote a server: never markup nor escapes
     names = (EPISODE_FILE, MAP_FILE, VIEWER_FILE)
     files = [out_dir / name for name in names if (out_dir / name).is_file()]
-    table.add_row("files", Text(", ".join(map(str, files)) or "none"))
+    table.add_row("files", Text(for_terminal(", ".join(map(str, files))) or "none"))
     return table
 
 
@@ -78,7 +82,9 @@ def run(
     scene: Annotated[str | None, typer.Option(
         help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
     )] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation, instantiation and start pose.")] = 0,
+    seed: Annotated[int, typer.Option(
+        min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation, instantiation and start pose."
+    )] = 0,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
@@ -92,7 +98,9 @@ def run(
     Exit status 1 when the episode ended in an error of the system (code raised, the LLM refused),
     75 when that error is transient (the LLM unreachable: run it again), 2 for bad input.
     """
-    from more_agent.eval.episode import ended_abnormally, run_episode
+    from more_agent.eval.episode import run_episode
+    from more_agent.eval.episode_folder import check_folder_for
+    from more_agent.eval.runlock import locked_run_dir
     from more_agent.eval.viewer import run_episode_with_viewer
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
     from more_agent.sim.start import check_start
@@ -110,10 +118,11 @@ def run(
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
     spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors)
-    with console.status(f"running {task} with planner {planner} ..."):
+    with locked_run_dir(out_dir), console.status(f"running {task} with planner {planner} ..."):
+        check_folder_for(out_dir, spec)
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
         )
     console.print(summary_table(record, out_dir))
-    if ended_abnormally(record):
-        raise typer.Exit(code=EXIT_RETRYABLE if record.retryable else EXIT_FAILED)
+    if status := episodes_exit_status([record]):
+        raise typer.Exit(code=status)

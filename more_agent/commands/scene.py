@@ -9,12 +9,12 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from more_agent.commands._common import check_output_file, console, user_errors_exit_2
+from more_agent.commands._common import MAX_SEED, check_output_file, console, user_errors_exit_2
 
 app = typer.Typer(help="BEHAVIOR-1K scenes: list, show, generate, render.", no_args_is_help=True)
 
 SCENE_ARG = typer.Argument(..., help="Scene name (e.g. Rs_int) or a path to a scene .json file.")
-SEED_OPT = typer.Option(0, "--seed", min=0, help="Layout seed; same scene and seed give the same plan.")
+SEED_OPT = typer.Option(0, "--seed", min=0, max=MAX_SEED, help="Layout seed; same scene and seed give the same plan.")
 
 
 @app.command("list")

@@ -8,7 +8,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from more_agent.commands._common import console, user_errors_exit_2
+from more_agent.commands._common import MAX_SEED, console, user_errors_exit_2
 
 app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.", no_args_is_help=True)
 
@@ -40,7 +40,7 @@ def list_(
 def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
     scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: drawn with the seed).")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation and instantiation.")] = 0,
+    seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation and instantiation.")] = 0,
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
     from more_agent.sim.instantiate import instantiate, literal_text

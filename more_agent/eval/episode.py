@@ -99,7 +99,7 @@ def run_episode(
     the slow per-step graph pictures unless ``save_graph`` asks for them
     (``more_agent.eval.viewer.run_episode_with_viewer`` then writes the page).
     """
-    from more_agent.llm.errors import LLMAuthError, LLMBadRequest, LLMError, LLMTransportError
+    from more_agent.llm.errors import LLMError
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
@@ -111,6 +111,8 @@ def run_episode(
     world: World | None = None
     goals: GoalChecker | None = None
     scope: dict[str, str] = {}
+    if folder is not None:
+        folder.clear()  # an earlier episode's steps and frames must never show in this one's viewer
     try:
         t = time.perf_counter()
         instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors)
@@ -133,7 +135,7 @@ def run_episode(
         _run_steps(record, planner, goals, world, clock, folder)
     except LLMError as e:
         record.error = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}"
-        record.retryable = isinstance(e, LLMTransportError) and not isinstance(e, (LLMAuthError, LLMBadRequest))
+        record.retryable = e.retryable
     except UserError as e:
         if strict:
             raise

@@ -9,13 +9,18 @@ file holds what, and when it is written: docs/evaluation.md, "Episode folder". P
 
 from __future__ import annotations
 
+import io
 import json
 import logging
+import shutil
 from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from more_agent.records import EpisodeRecord
+from more_agent.errors import UserError
+from more_agent.record_validation import parse_record, record_json
+from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.safe_files import append_text, make_dir, read_bounded, write_atomic
 
 if TYPE_CHECKING:
     import numpy as np
@@ -48,6 +53,34 @@ def map_is_complete(path: Path) -> bool:
             return f.read().endswith(_PNG_END)
     except OSError:
         return False
+
+
+def read_record(path: Path) -> EpisodeRecord:
+    """The validated record of an ``episode.json`` (a UserError naming the file and the problem)."""
+    return parse_record(read_bounded(path, what="episode record"), source=str(path))
+
+
+def check_folder_for(path: Path, spec: EpisodeSpec) -> None:
+    """Raise a UserError when the folder ``path`` holds a finished episode of another spec than ``spec``.
+
+    An earlier run of the same episode, or an unfinished or unreadable one, is not refused: the
+    episode runner clears its files (:meth:`EpisodeFolder.clear`) before writing the new ones.
+    """
+    record_path = Path(path) / EPISODE_FILE
+    if not record_path.is_file() or record_path.is_symlink():
+        return
+    try:
+        old = read_record(record_path)
+    except UserError:
+        return
+    same = (old.task, old.seed, old.planner, old.llm, old.start) == (spec.task, spec.seed, spec.planner, spec.llm, spec.start)
+    same = same and old.distractors in (None, spec.distractors)
+    same = same and (spec.scene is None or spec.scene.endswith(".json") or spec.scene == old.scene)
+    if not same:
+        raise UserError(
+            f"{path} holds another episode ({old.task} in {old.scene}, seed {old.seed}, planner {old.planner}, "
+            f"llm {old.llm}, start {old.start}); choose another --out, or delete that folder to replace it"
+        )
 
 
 class EpisodeFolder:
@@ -85,14 +118,28 @@ class EpisodeFolder:
         """An annotated image (``view``, ``object``) the VLM was shown in ``step``."""
         return self.path / VLM_IMAGES_DIR / f"step_{step:03d}_{kind}.png"
 
+    def owned_paths(self) -> list[Path]:
+        """Every file and folder of an episode this module writes (what :meth:`clear` removes)."""
+        return [self.record_path, self.map_path, self.timeline_path, self.steps_path, self.viewer_path,
+                self.frames_dir, self.graphs_dir, self.path / VLM_IMAGES_DIR]
+
     # -- writing --------------------------------------------------------------------------------
+    def clear(self) -> None:
+        """Remove an earlier episode's files from the folder (only the names this module owns; a
+        symlink is removed itself, never followed), so a new episode never shows an old one's steps."""
+        for path in self.owned_paths():
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink(missing_ok=True)
+
     def start(self, *, steps_log: bool) -> None:
         """Begin the per-step files of a run into this folder: an empty ``timeline.jsonl`` and, for a
         planner that logs its steps (LLM and VLM planners), an empty ``steps.jsonl``."""
         self.path.mkdir(parents=True, exist_ok=True)
-        self.timeline_path.write_text("", encoding="utf-8")
+        write_atomic(self.timeline_path, b"", durable=False)
         if steps_log:
-            self.steps_path.write_text("", encoding="utf-8")
+            write_atomic(self.steps_path, b"", durable=False)
 
     def frame_writer(self, class_names: list[str]) -> Callable[[Frame], None] | None:
         """The hook that writes every rendered frame as a numbered PNG triple (None without ``frames``).
@@ -106,7 +153,7 @@ class EpisodeFolder:
         def write(frame: Frame) -> None:
             from more_agent.viz.frames import frame_pictures  # lazy: matplotlib only when writing frames
 
-            self.frames_dir.mkdir(parents=True, exist_ok=True)
+            make_dir(self.frames_dir)
             for kind, picture in frame_pictures(frame.rgb, frame.depth, frame.semantic, class_names).items():
                 _save_png(picture, self.frame_path(self.frames_written, kind))
             self.frames_written += 1
@@ -123,8 +170,8 @@ class EpisodeFolder:
         if self.frames:
             for kind, png in trace.pictures.items():
                 path = self.vlm_image_path(step, kind)
-                path.parent.mkdir(exist_ok=True)
-                path.write_bytes(png)
+                make_dir(path.parent)
+                write_atomic(path, png, durable=False)
         if self.graphs and trace.graph is not None:
             self._write_graph(step, trace.graph)
         _append_line(self.timeline_path, {
@@ -140,12 +187,12 @@ class EpisodeFolder:
     def _write_graph(self, step: int, graph: SceneGraph) -> None:
         from more_agent.viz.graph_plot import occupancy_png, scene_graph_png
 
-        self.graphs_dir.mkdir(parents=True, exist_ok=True)
-        self.graph_path(step).write_text(graph.model_dump_json(), encoding="utf-8")
+        make_dir(self.graphs_dir)
+        write_atomic(self.graph_path(step), graph.model_dump_json(), durable=False)
         if graph.occupancy is not None:
-            self.graph_path(step, "_occupancy.png").write_bytes(occupancy_png(graph.occupancy))
+            write_atomic(self.graph_path(step, "_occupancy.png"), occupancy_png(graph.occupancy), durable=False)
         if self.graph_pictures:
-            self.graph_path(step, ".png").write_bytes(scene_graph_png(graph, title=f"step {step}"))
+            write_atomic(self.graph_path(step, ".png"), scene_graph_png(graph, title=f"step {step}"), durable=False)
 
     def write_map(self, record: EpisodeRecord, world: World | None, labelled: Collection[str]) -> None:
         """The map picture (when the world was built); a picture that fails is logged, never costs the record."""
@@ -157,29 +204,30 @@ class EpisodeFolder:
         try:
             png = trajectory_map_png(world, record.trajectory, title=f"{record.task} ({record.scene}, {record.planner})",
                                      labelled=labelled)
-            self.map_path.write_bytes(png)
+            write_atomic(self.map_path, png)
         except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
             log.warning("could not draw %s: %s: %s", self.map_path, type(e).__name__, e)
 
     def write_record(self, record: EpisodeRecord) -> None:
-        """``episode.json``, written last (with the final timings)."""
+        """``episode.json``, written last (with the final timings), all at once: a full disk leaves none."""
         self.path.mkdir(parents=True, exist_ok=True)
-        self.record_path.write_text(record.model_dump_json(indent=2) + "\n", encoding="utf-8")
+        write_atomic(self.record_path, record_json(record, indent=2) + "\n")
 
     def write_viewer(self, html: str, out: Path | None = None) -> Path:
         """The viewer page, to ``out`` (default ``viewer.html`` in the folder); return its path."""
         path = Path(out) if out is not None else self.viewer_path
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(html, encoding="utf-8")
+        write_atomic(path, html)
         return path
 
 
 def _append_line(path: Path, line: Mapping[str, Any]) -> None:
-    with path.open("a", encoding="utf-8") as f:
-        f.write(json.dumps(line) + "\n")
+    append_text(path, json.dumps(line) + "\n")
 
 
 def _save_png(picture: np.ndarray, path: Path) -> None:
     from PIL import Image
 
-    Image.fromarray(picture).save(path)
+    buf = io.BytesIO()
+    Image.fromarray(picture).save(buf, format="PNG")
+    write_atomic(path, buf.getvalue(), durable=False)

@@ -25,20 +25,20 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.eval.runlock import locked_run_dir
 from more_agent.eval.store import (
-    EPISODE_DIRS,
     EPISODES_FILE,
     EpisodeWriter,
     RunConfig,
     check_run_dir,
-    episode_dirname,
+    episode_dir,
     pending,
     prepare_run_dir,
     retire_retryable,
 )
 from more_agent.eval.worker import error_record, execute_episode, resolve_episode_fn
-from more_agent.interrupts import interrupted
+from more_agent.interrupts import ignore_interrupts, interrupted
 from more_agent.llm.concurrency import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.safe_files import read_bounded
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
 """Dotted path of the real episode function."""
@@ -47,6 +47,9 @@ VIEWER_EPISODE_FN = "more_agent.eval.viewer:run_episode_with_viewer"
 
 DEFAULT_MAX_RETRIES = 2
 """Re-runs of an episode whose worker process died before it is recorded as an error."""
+
+MAX_TASK_FILE_BYTES = 1024 * 1024
+"""Largest ``--tasks`` file read (about 30,000 task names)."""
 
 
 
@@ -76,15 +79,12 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
     if arg in tasks.TASK_SETS:
         names = (task_set or tasks.task_set)(arg)
     elif _is_file(path):
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            raise UserError(f"cannot read task file {path}: {getattr(e, 'strerror', None) or e}") from None
+        text = read_bounded(path, what="task file", max_bytes=MAX_TASK_FILE_BYTES)  # a byte-order mark dropped
         if text.lstrip().startswith("["):
             try:
                 names = json.loads(text)
-            except json.JSONDecodeError as e:
-                raise UserError(f"{path}: not a JSON list of task names: {e}") from None
+            except (json.JSONDecodeError, RecursionError) as e:
+                raise UserError(f"{path}: not a JSON list of task names: {str(e)[:200] or 'nested too deeply'}") from None
             if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
                 raise UserError(f"{path}: expected a JSON list of task names (strings)")
         else:
@@ -126,7 +126,8 @@ def _exit_when_orphaned(parent_pid: int) -> None:
 
 
 def _init_worker(limiter: LLMConcurrencyLimiter | None, parent_pid: int) -> None:
-    """Pool worker start-up: install the shared LLM limiter and exit if the parent dies."""
+    """Pool worker start-up: leave Ctrl-C to the parent, install the shared LLM limiter, exit if the parent dies."""
+    ignore_interrupts()
     set_llm_limiter(limiter)
     threading.Thread(target=_exit_when_orphaned, args=(parent_pid,), daemon=True).start()
 
@@ -189,6 +190,9 @@ def iter_processes(
                         continue
                     suspects.discard(i)
                     yield record
+        except BaseException:  # Ctrl-C, SIGTERM, a closed generator: stop the episodes in flight now
+            _stop_workers()
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
         victims = [i for i in failed if i >= 0]
@@ -200,6 +204,14 @@ def iter_processes(
             if deaths[i] > max_retries:
                 yield error_record(specs[i], f"WorkerDied: worker process died {deaths[i]} times", retryable=True)
         queue.extendleft(reversed([i for i in victims if deaths[i] <= max_retries]))
+
+
+def _stop_workers() -> None:
+    """Terminate this process's worker processes (they ignore Ctrl-C; the parent decides when they stop)."""
+    for child in multiprocessing.active_children():
+        child.terminate()
+    for child in multiprocessing.active_children():
+        child.join(timeout=5)
 
 
 def _may_start(i: int, inflight: dict[Future[EpisodeRecord], int], suspects: set[int]) -> bool:
@@ -266,11 +278,11 @@ def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeR
     from more_agent.eval.episode import redraw_map
     from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
 
-    by_key = {(r.task, r.seed, r.planner): r for r in records}
+    by_key = {(r.task, r.seed, r.planner, r.llm, r.start): r for r in records}
     redrawn = 0
     for spec in config_specs(config):
-        record = by_key.get((spec.task, spec.seed, spec.planner))
-        out_dir = run_dir / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+        record = by_key.get((spec.task, spec.seed, spec.planner, spec.llm, spec.start))
+        out_dir = episode_dir(run_dir, spec)
         if record is None or not record.trajectory or not out_dir.is_dir() or map_is_complete(out_dir / MAP_FILE):
             continue
         try:

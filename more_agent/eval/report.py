@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import io
+from html import escape
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -18,6 +19,7 @@ from more_agent.eval.failure import CAUSE_ORDER, cause_counts
 from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task, group_by, system_label
 from more_agent.eval.store import EPISODES_FILE, read_records
 from more_agent.records import EpisodeRecord
+from more_agent.redaction import for_terminal
 
 SUMMARY_MD = "summary.md"
 SUMMARY_CSV = "summary.csv"
@@ -59,9 +61,15 @@ def fmt(e: Estimate) -> str:
     return f"{100 * e.mean:.1f} [{100 * e.low:.1f}, {100 * e.high:.1f}]"
 
 
+def md_text(text: str) -> str:
+    """Record text (a model name, a task name) made inert in Markdown: HTML and pipes escaped,
+    credentials masked, escape sequences dropped (the tables are printed to the terminal too)."""
+    return escape(for_terminal(text), quote=False).replace("|", "\\|")
+
+
 def _md_table(header: list[str], rows: list[list[str]]) -> str:
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in rows]
+    lines += ["| " + " | ".join(md_text(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
 
 
@@ -97,7 +105,7 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
     """The whole summary.md: Table I, notes on the metrics, the per-task table."""
     return "\n\n".join(
         [
-            f"# {title}",
+            f"# {md_text(title)}",
             table_i_markdown(records),
             "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
             "rTP. Episodes are weighted equally; errored episodes count as failures. rTP is 0 for an "

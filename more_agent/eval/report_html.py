@@ -19,7 +19,7 @@ from urllib.parse import quote
 from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
 from more_agent.eval.report import SourcedRecord, fmt
-from more_agent.eval.store import EPISODE_DIRS, episode_dirname
+from more_agent.eval.store import EPISODE_DIRS, episode_dir, episode_dirname
 from more_agent.records import EpisodeRecord
 
 THUMB_PX = 160
@@ -36,11 +36,13 @@ img.plot{max-width:560px;max-height:420px;border:1px solid #ddd}pre{background:#
 
 
 def episode_file(record: EpisodeRecord, run_dir: Path, name: str) -> Path | None:
-    """A file of the episode's folder under ``run_dir/episodes/``, looked up by resolved scene then 'auto'."""
+    """A file of the episode's folder under ``run_dir/episodes/``, looked up by resolved scene then 'auto'
+    (and in the folders of runs written before the LLM, start and distractors were part of the name)."""
     for scene in (record.scene or None, None):
-        p = Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner) / name
-        if p.is_file():
-            return p
+        for folder in (episode_dir(run_dir, record, scene or "auto"),
+                       Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner)):
+            if (folder / name).is_file():
+                return folder / name
     return None
 
 

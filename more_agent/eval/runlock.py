@@ -3,7 +3,8 @@
 Two ``more-agent eval --resume`` on one folder would both run every missing episode and record it
 twice. The writer holds ``flock`` on ``DIR/.lock`` for the whole run; the operating system drops
 the lock when the process ends, however it ends (kill -9 included), so a stale lock never blocks a
-resume. The file says who holds it, for the message the second writer gets. POSIX only.
+resume. The file says who holds it, for the message the second writer gets. ``more-agent run`` takes
+the same lock on its episode folder. A ``.lock`` that is a symlink is refused (never followed). POSIX only.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from more_agent.errors import UserError
+from more_agent.safe_files import open_nofollow
 
 LOCK_FILE = ".lock"
 """Name of the lock file inside a run folder."""
@@ -31,7 +33,7 @@ def locked_run_dir(run_dir: Path) -> Iterator[None]:
     import fcntl
 
     run_dir.mkdir(parents=True, exist_ok=True)
-    fd = os.open(run_dir / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+    fd = open_nofollow(run_dir / LOCK_FILE, os.O_RDWR | os.O_CREAT)  # a symlinked .lock is refused, its target kept
     try:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)

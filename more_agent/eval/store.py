@@ -9,6 +9,7 @@ at worst leaves one torn last line. ``read_records`` drops a torn last line (and
 from __future__ import annotations
 
 import functools
+import hashlib
 import json
 import os
 import re
@@ -18,14 +19,19 @@ from types import TracebackType
 from pydantic import BaseModel, Field, ValidationError
 
 from more_agent.errors import UserError, check_writable_dir
+from more_agent.redaction import redact_tree
 from more_agent.eval.runlock import LOCK_FILE
+from more_agent.record_validation import BadRecord, parse_record, record_json
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.safe_files import open_nofollow, read_bounded, write_atomic
 
 EPISODES_FILE = "episodes.jsonl"
 RETRIED_FILE = "retried.jsonl"
 """Error records that ``--retry-errors`` replaced, kept for the record (not part of the results)."""
 RUN_FILE = "run.json"
 EPISODE_DIRS = "episodes"
+MAX_STORE_BYTES = 2 * 1024**3
+"""Largest ``episodes.jsonl`` read (about a million episodes)."""
 
 
 class RunConfig(BaseModel):
@@ -42,6 +48,10 @@ class RunConfig(BaseModel):
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
     more_agent_version: str = Field(default="", description="Package version that wrote the run.")
+    earlier: list[dict[str, object]] = Field(
+        default_factory=list,
+        description="The settings (MIXING_FIELDS) of earlier runs whose episodes --allow-mixed kept in this folder.",
+    )
 
 
 MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "episode_fn")
@@ -90,7 +100,9 @@ class TornStoreError(UserError):
 
 
 def _parse_lines(data: bytes, path: Path) -> tuple[list[EpisodeRecord], int]:
-    """Records of complete lines and the byte length of the valid prefix; a bad last line is dropped."""
+    """Records of complete lines and the byte length of the valid prefix; a last line that is not JSON
+    (torn by a kill) is dropped. A record that is JSON but not a valid record is an error wherever it is:
+    dropping it would lose an episode someone edited."""
     records: list[EpisodeRecord] = []
     good_end = 0
     pos = 0
@@ -101,15 +113,23 @@ def _parse_lines(data: bytes, path: Path) -> tuple[list[EpisodeRecord], int]:
         end = nl + 1
         line = data[pos:end].strip()
         if line:
+            if not data[end:].strip() and not _is_json(line):
+                break  # garbled last line: drop it
             try:
-                records.append(EpisodeRecord.model_validate_json(line))
-            except ValidationError as e:
-                if not data[end:].strip():
-                    break  # garbled last line: drop it
-                raise TornStoreError(f"{path}: unreadable record at byte {pos}: {e.errors()[0]['msg']}") from None
+                records.append(parse_record(line, source=f"{path}: unreadable record at byte {pos}"))
+            except BadRecord as e:
+                raise TornStoreError(str(e)) from None
         good_end = end
         pos = end
     return records, good_end
+
+
+def _is_json(line: bytes) -> bool:
+    try:
+        json.loads(line)
+    except (ValueError, RecursionError):
+        return False
+    return True
 
 
 def read_records(path: Path, *, repair: bool = False) -> list[EpisodeRecord]:
@@ -122,7 +142,7 @@ def read_records(path: Path, *, repair: bool = False) -> list[EpisodeRecord]:
         path = path / EPISODES_FILE
     if not path.exists():
         return []
-    data = path.read_bytes()
+    data = read_bounded(path, what="run records", max_bytes=MAX_STORE_BYTES).encode("utf-8")
     records, good_end = _parse_lines(data, path)
     if repair and good_end < len(data):
         with open(path, "r+b") as fh:
@@ -137,11 +157,11 @@ class EpisodeWriter:
 
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
-        self._fh = open(self.path, "ab")
+        self._fh = os.fdopen(open_nofollow(self.path, os.O_WRONLY | os.O_CREAT | os.O_APPEND), "ab")
 
     def append(self, record: EpisodeRecord) -> None:
         """Write one record as one line and make it durable before returning."""
-        self._fh.write(record.model_dump_json().encode("utf-8") + b"\n")
+        self._fh.write(record_json(record).encode("utf-8") + b"\n")
         self._fh.flush()
         os.fsync(self._fh.fileno())
 
@@ -186,13 +206,16 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
 
 
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
-    """The specs with no record yet, in order; a record of a scene file's scene counts for the file."""
-    done: dict[tuple[str, int, str], set[str]] = {}
+    """The specs with no record yet, in order: a record counts for a spec when it shares task, seed,
+    planner, LLM, start and distractors (a record that predates the distractors field matches either)
+    and scene (a record of a scene file's scene counts for the file)."""
+    done: dict[tuple[str, int, str, str | None, str], list[EpisodeRecord]] = {}
     for r in records:
-        done.setdefault((r.task, r.seed, r.planner), set()).add(r.scene)
+        done.setdefault((r.task, r.seed, r.planner, r.llm, r.start), []).append(r)
     out = []
     for s in specs:
-        scenes = done.get((s.task, s.seed, s.planner))
+        scenes = {r.scene for r in done.get((s.task, s.seed, s.planner, s.llm, s.start), [])
+                  if r.distractors in (None, s.distractors)}
         if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
     return out
@@ -211,17 +234,35 @@ def _scene_name(scene: str) -> str:
         return scene
 
 
-def episode_dirname(task: str, scene: str | None, seed: int, planner: str) -> str:
-    """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene."""
-    raw = f"{task}__{scene or 'auto'}__s{seed}__{planner}"
-    return re.sub(r"[^A-Za-z0-9_.\-]", "_", raw)
+def episode_dirname(
+    task: str, scene: str | None, seed: int, planner: str, *,
+    llm: str | None = None, start: str = "random", distractors: bool | None = True,
+) -> str:
+    """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
+
+    The LLM, a start other than 'random' and ``--no-distractors`` are part of the name, so that the
+    episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a folder.
+    """
+    parts = [task, scene or "auto", f"s{seed}", planner]
+    if llm is not None:
+        parts.append(llm if len(llm) <= 60 else f"{llm[:40]}-{hashlib.sha256(llm.encode()).hexdigest()[:8]}")
+    if start != "random":
+        parts.append(start)
+    if distractors is False:
+        parts.append("nodistractors")
+    return re.sub(r"[^A-Za-z0-9_.\-]", "_", "__".join(parts))
+
+
+def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str | None = None) -> Path:
+    """The folder of ``episode``'s files in the run folder ``run_dir`` (``scene`` in place of its own)."""
+    name = episode_dirname(episode.task, scene if scene is not None else episode.scene, episode.seed, episode.planner,
+                           llm=episode.llm, start=episode.start, distractors=episode.distractors)
+    return Path(run_dir) / EPISODE_DIRS / name
 
 
 def write_run_config(run_dir: Path, config: RunConfig) -> None:
     """Write ``DIR/run.json`` atomically (temp file + rename)."""
-    tmp = run_dir / (RUN_FILE + ".tmp")
-    tmp.write_text(config.model_dump_json(indent=2) + "\n", encoding="utf-8")
-    os.replace(tmp, run_dir / RUN_FILE)
+    write_atomic(run_dir / RUN_FILE, json.dumps(redact_tree(config.model_dump(mode="json")), indent=2) + "\n")
 
 
 def read_run_config(run_dir: Path) -> RunConfig | None:
@@ -230,8 +271,8 @@ def read_run_config(run_dir: Path) -> RunConfig | None:
     if not path.exists():
         return None
     try:
-        return RunConfig.model_validate(json.loads(path.read_text(encoding="utf-8")))
-    except (ValueError, ValidationError) as e:
+        return RunConfig.model_validate(json.loads(read_bounded(path, what="run configuration")))
+    except (ValueError, ValidationError, RecursionError) as e:
         raise UserError(f"{path} is not a valid run configuration: {e}") from None
 
 
@@ -261,6 +302,9 @@ def prepare_run_dir(
     old = read_run_config(run_dir) or (_config_of_records(records, config) if records else None)
     if old is not None and not allow_mixed:
         check_same_run(run_dir, old, config)
+    if old is not None and _comparable(old) != _comparable(config):  # mixed: run.json says what else is here
+        earlier = [*old.earlier, old.model_dump(include=set(MIXING_FIELDS))]
+        config = config.model_copy(update={"earlier": earlier})
     records = read_records(run_dir / EPISODES_FILE, repair=True)
     write_run_config(run_dir, config)
     return records

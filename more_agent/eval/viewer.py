@@ -28,8 +28,9 @@ from PIL import Image
 
 from more_agent.errors import UserError
 from more_agent.eval.episode import run_episode
-from more_agent.eval.episode_folder import EPISODE_FILE, EpisodeFolder
+from more_agent.eval.episode_folder import EPISODE_FILE, EpisodeFolder, read_record
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.safe_files import read_bounded
 from more_agent.sim.grid import Grid
 
 log = logging.getLogger(__name__)
@@ -141,9 +142,21 @@ def scene_segments(full: str, kept: str) -> list[list[list[Any]]]:
 
 
 def _read_jsonl(path: Path) -> list[dict[str, Any]]:
+    """The step lines of ``timeline.jsonl`` or ``steps.jsonl``; a torn or foreign line is a UserError naming it."""
     if not path.is_file():
         return []
-    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+    lines = []
+    for n, line in enumerate(read_bounded(path, what="step log").splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            value = json.loads(line)
+        except (ValueError, RecursionError):
+            raise UserError(f"{path}: line {n} is not JSON (a torn or edited file); re-run the episode") from None
+        if not isinstance(value, dict) or not isinstance(value.get("step"), int):
+            raise UserError(f"{path}: line {n} is not a step line (no integer 'step')")
+        lines.append(value)
+    return lines
 
 
 def _thumbnail(url: str) -> str:
@@ -197,7 +210,7 @@ def viewer_data(episode_dir: Path) -> dict[str, Any]:
     folder = EpisodeFolder(Path(episode_dir))
     if not folder.record_path.is_file():
         raise UserError(f"{episode_dir} is not an episode folder (no {EPISODE_FILE}); 'more-agent run' writes one")
-    record = EpisodeRecord.model_validate_json(folder.record_path.read_text(encoding="utf-8"))
+    record = read_record(folder.record_path)
     timeline = {t["step"]: t for t in _read_jsonl(folder.timeline_path)}
     llm_steps = {s["step"]: s for s in _read_jsonl(folder.steps_path)}
     steps, first_frame = [], 0
@@ -237,8 +250,15 @@ def render_viewer(data: dict[str, Any]) -> str:
 
 
 def write_viewer(episode_dir: Path, out: Path | None = None) -> Path:
-    """Write the viewer of ``episode_dir`` to ``out`` (default ``episode_dir/viewer.html``); return its path."""
-    return EpisodeFolder(Path(episode_dir)).write_viewer(render_viewer(viewer_data(Path(episode_dir))), out)
+    """Write the viewer of ``episode_dir`` to ``out`` (default ``episode_dir/viewer.html``); return its path.
+
+    Files that are JSON but not what this version writes (an edited or foreign step line) are a
+    UserError naming the folder, as torn ones are."""
+    try:
+        data = viewer_data(Path(episode_dir))
+    except (KeyError, TypeError, IndexError) as e:
+        raise UserError(f"{episode_dir}: a step file holds a line this version cannot read ({type(e).__name__}: {e})") from None
+    return EpisodeFolder(Path(episode_dir)).write_viewer(render_viewer(data), out)
 
 
 def run_episode_with_viewer(spec: EpisodeSpec, *, out_dir: Path | None = None, **kwargs: Any) -> EpisodeRecord:

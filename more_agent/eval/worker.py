@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from more_agent.errors import UserError
-from more_agent.eval.store import EPISODE_DIRS, episode_dirname
+from more_agent.eval.store import episode_dir
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import redact
 
@@ -43,7 +43,7 @@ def error_record(spec: EpisodeSpec, error: str, tb: str | None = None, *, retrya
 
 def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRecord:
     """Run one episode; an exception becomes an error record. Idempotent: writes only its own dir."""
-    out_dir = Path(run_dir) / EPISODE_DIRS / episode_dirname(spec.task, spec.scene, spec.seed, spec.planner)
+    out_dir = episode_dir(Path(run_dir), spec)
     start = time.perf_counter()
     try:
         out_dir.mkdir(parents=True, exist_ok=True)

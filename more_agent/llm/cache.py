@@ -1,10 +1,12 @@
 """sqlite response cache shared by parallel evaluation processes.
 
 One table keyed by a sha256 over the request (backend kind, model, messages, sampling parameters,
-JSON schema, attempt number). It stores the request for inspection and the answer text and token
-counts; never credentials (the key is not part of a request). WAL journaling and a busy timeout let
-several processes read and write at once; each process opens its own connection (re-opened after
-a fork).
+JSON schema, attempt number). It stores the request for inspection (every string redacted: a model
+name or a prompt holding a key is stored masked) and the answer text and token counts; never
+credentials (the key is not part of a request). WAL journaling and a busy timeout let several
+processes read and write at once; each process opens its own connection (re-opened after a fork).
+A cache still locked by another process after the busy timeout is :class:`CacheLocked`, a transient
+error (the episode is retryable); any other sqlite failure is :class:`CacheUnusable`, bad input.
 """
 
 from __future__ import annotations
@@ -19,7 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from more_agent.llm import constants as C
-from more_agent.llm.errors import LLMConfigError
+from more_agent.llm.errors import CacheLocked, LLMConfigError
+from more_agent.redaction import redact_tree
 
 
 class CacheUnusable(LLMConfigError):
@@ -79,7 +82,13 @@ class ResponseCache:
         try:
             return self._open()
         except (sqlite3.Error, OSError) as e:
-            raise CacheUnusable(f"cannot open LLM cache {self.path}: {e}") from None
+            raise self._error("open", e) from None
+
+    def _error(self, doing: str, e: Exception) -> CacheLocked | CacheUnusable:
+        """The typed error of a failed sqlite operation: locked or busy is transient, the rest is not."""
+        if isinstance(e, sqlite3.OperationalError) and ("locked" in str(e) or "busy" in str(e)):
+            return CacheLocked(f"LLM cache {self.path} stayed locked by another process for {self._busy_timeout_s:g} s: {e}")
+        return CacheUnusable(f"cannot {doing} LLM cache {self.path}: {e}")
 
     def _open(self) -> sqlite3.Connection:
         if self._conn is None or self._pid != os.getpid():
@@ -99,7 +108,7 @@ class ResponseCache:
                 "SELECT text, model, prompt_tokens, completion_tokens FROM responses WHERE key = ?", (key,)
             ).fetchone()
         except sqlite3.Error as e:
-            raise CacheUnusable(f"cannot read LLM cache {self.path}: {e}") from None
+            raise self._error("read", e) from None
         return CachedAnswer(*row) if row else None
 
     def put(self, key: str, *, request: dict[str, Any], purpose: str, answer: CachedAnswer) -> None:
@@ -107,7 +116,7 @@ class ResponseCache:
         try:
             self._insert(key, request=request, purpose=purpose, answer=answer)
         except sqlite3.Error as e:
-            raise CacheUnusable(f"cannot write LLM cache {self.path}: {e}") from None
+            raise self._error("write", e) from None
 
     def _insert(self, key: str, *, request: dict[str, Any], purpose: str, answer: CachedAnswer) -> None:
         self._connection().execute(
@@ -116,7 +125,7 @@ class ResponseCache:
                 key,
                 answer.model,
                 purpose,
-                json.dumps(request, sort_keys=True),
+                json.dumps(redact_tree(request), sort_keys=True),
                 answer.text,
                 answer.prompt_tokens,
                 answer.completion_tokens,

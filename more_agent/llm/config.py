@@ -15,10 +15,20 @@ from collections.abc import Mapping
 from enum import StrEnum
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict, Field, SecretStr, ValidationError
+from urllib.parse import urlsplit
 
+from pydantic import BaseModel, ConfigDict, Field, SecretStr, ValidationError, field_validator
+
+from more_agent.errors import UserError
 from more_agent.llm import constants as C
 from more_agent.llm.errors import LLMConfigError
+from more_agent.redaction import has_credentials
+from more_agent.safe_files import read_bounded
+
+MAX_CONFIG_BYTES = 1024 * 1024
+"""Largest LLM config file read (a real one is under a kilobyte; ``/dev/zero`` is refused)."""
+MAX_TIMEOUT_S = 3600.0
+"""Longest ``timeout_s`` accepted: one request's whole wall-clock deadline."""
 
 
 class CacheMode(StrEnum):
@@ -57,7 +67,7 @@ class ModelPrice(BaseModel):
 class LLMConfig(BaseModel):
     """Everything about how LLMs are reached; which LLM is the ``llm`` spec (or ``--llm``)."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     llm: str | None = Field(
         default=None, description="Default LLM spec ('openai:gpt-4o', 'llamacpp:PATH.gguf'); None = no LLM configured."
@@ -76,10 +86,13 @@ class LLMConfig(BaseModel):
     temperature: float = Field(default=C.DEFAULT_TEMPERATURE, ge=0, le=2, description="Sampling temperature.")
     max_tokens: int = Field(default=C.DEFAULT_MAX_TOKENS, gt=0, description="Upper bound on tokens of one answer.")
     seed: int | None = Field(default=None, description="Sampling seed sent to servers that honour it.")
-    timeout_s: float = Field(default=C.DEFAULT_TIMEOUT_S, gt=0, description="Seconds per HTTP request.")
+    timeout_s: float = Field(
+        default=C.DEFAULT_TIMEOUT_S, gt=0, le=MAX_TIMEOUT_S,
+        description="Wall-clock seconds one HTTP request may take in all: connect, headers and body.",
+    )
     max_retries: int = Field(default=C.DEFAULT_MAX_RETRIES, ge=0, description="Retries on timeouts, 429, 5xx, drops.")
-    backoff_initial_s: float = Field(default=C.INITIAL_BACKOFF_S, ge=0, description="First sleep between retries.")
-    backoff_max_s: float = Field(default=C.MAX_BACKOFF_S, ge=0, description="Longest sleep between retries.")
+    backoff_initial_s: float = Field(default=C.INITIAL_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="First sleep between retries.")
+    backoff_max_s: float = Field(default=C.MAX_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="Longest sleep between retries.")
     structured_output: StructuredOutput = Field(
         default=StructuredOutput.AUTO, description="Send JSON schemas as response_format: auto, always or never."
     )
@@ -95,6 +108,41 @@ class LLMConfig(BaseModel):
         description="CPU threads of in-process GGUF models, prompts and generation; None = llama.cpp's choice.",
     )
 
+    @field_validator("llm", "room_model")
+    @classmethod
+    def _no_credentials(cls, value: str | None) -> str | None:
+        """Model names go into records, caches and run.json: one holding a key is refused."""
+        if value is not None and has_credentials(value):
+            raise ValueError("must not contain credentials; put the key in OPENAI_API_KEY")
+        return value
+
+    @field_validator("base_url")
+    @classmethod
+    def _http_url(cls, value: str | None) -> str | None:
+        """An http(s) URL with a host and a valid port, without credentials (they would reach logs)."""
+        if value is None:
+            return None
+        if has_credentials(value):
+            raise ValueError(f"must not contain credentials; put the key in {C.ENV_API_KEY}")
+        try:
+            parts = urlsplit(value.strip())
+            port = parts.port
+        except ValueError as e:
+            raise ValueError(f"{value!r} is not a URL: {e}") from None
+        if parts.scheme not in ("http", "https") or not parts.hostname:
+            raise ValueError(f"{value!r} is not an http(s) URL such as http://127.0.0.1:8080/v1")
+        if port == 0:
+            raise ValueError(f"{value!r} has port 0")
+        return value.strip()
+
+    @field_validator("api_key")
+    @classmethod
+    def _header_safe_key(cls, value: SecretStr | None) -> SecretStr | None:
+        """A key is sent in an HTTP header: control characters (CR, LF) or non-ASCII cannot be."""
+        if value is not None and not all(" " < c < "\x7f" for c in value.get_secret_value()):
+            raise ValueError("holds a control character, a space or a non-ASCII character; check the key")
+        return value
+
     def api_key_value(self) -> str | None:
         """The API key as plain text, for the one place that sends it."""
         return self.api_key.get_secret_value() if self.api_key is not None else None
@@ -103,13 +151,13 @@ class LLMConfig(BaseModel):
 def _read_file(path: Path) -> dict[str, object]:
     """The settings table of a TOML or JSON config file."""
     try:
-        raw = path.read_bytes()
-    except OSError as e:
-        raise LLMConfigError(f"cannot read LLM config {path}: {e.strerror}") from None
+        raw = read_bounded(path, what="LLM config", max_bytes=MAX_CONFIG_BYTES)
+    except UserError as e:
+        raise LLMConfigError(str(e)) from None
     try:
-        doc = json.loads(raw) if path.suffix == ".json" else tomllib.loads(raw.decode())
-    except (ValueError, UnicodeDecodeError) as e:
-        raise LLMConfigError(f"cannot parse LLM config {path}: {e}") from None
+        doc = json.loads(raw) if path.suffix == ".json" else tomllib.loads(raw)
+    except (ValueError, RecursionError) as e:
+        raise LLMConfigError(f"cannot parse LLM config {path}: {str(e)[:200]}") from None
     if not isinstance(doc, dict):
         raise LLMConfigError(f"LLM config {path} must hold a table/object")
     table = doc.get("llm", doc)

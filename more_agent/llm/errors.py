@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from more_agent.errors import UserError
 from more_agent.llm.limits import MAX_ANSWER_CHARS, MAX_ERROR_CHARS, clip
-from more_agent.redaction import redact
+from more_agent.redaction import for_terminal
 
 if TYPE_CHECKING:
     from more_agent.llm.completion import Completion
@@ -21,16 +21,22 @@ if TYPE_CHECKING:
 class LLMError(Exception):
     """Base class of everything that goes wrong while asking a model.
 
-    The message quotes server or model text: it is clipped and key-shaped strings are redacted, so
-    it can go into a record or onto the terminal as it is.
+    The message quotes server or model text: it is clipped, key-shaped strings are redacted and
+    escape sequences stripped, so it can go into a record or onto the terminal as it is.
+    ``retryable`` says whether an episode that ended in it is worth running again (a transient
+    cause: ``eval --resume --retry-errors`` re-runs it; ``run`` exits 75).
     """
 
+    retryable = False
+
     def __init__(self, message: str = "") -> None:
-        super().__init__(clip(redact(message), MAX_ERROR_CHARS))
+        super().__init__(clip(for_terminal(message), MAX_ERROR_CHARS))
 
 
 class LLMTransportError(LLMError):
     """The request did not produce an answer; ``attempts`` says how many tries were made."""
+
+    retryable = True
 
     def __init__(self, message: str, *, attempts: int = 1) -> None:
         super().__init__(message)
@@ -64,9 +70,27 @@ class LLMServerError(LLMStatusError):
 class LLMBadRequest(LLMStatusError):
     """HTTP 4xx the server will not change its mind about (400, 404, 422, ...); never retried."""
 
+    retryable = False
+
 
 class LLMAuthError(LLMStatusError):
     """HTTP 401/403: the API key is missing, wrong or lacks access; never retried."""
+
+    retryable = False
+
+
+class LLMResponseTooLarge(LLMTransportError):
+    """The response body is over ``MAX_BODY_BYTES`` (:mod:`more_agent.llm.http`); reading stopped there.
+
+    Never retried and not retryable: no valid answer is that large, so the server is broken or
+    hostile and asking again would only download it again.
+    """
+
+    retryable = False
+
+
+class CacheLocked(LLMTransportError):
+    """The response cache stayed locked by another process for the whole busy timeout: transient."""
 
 
 class Unparseable(LLMError):

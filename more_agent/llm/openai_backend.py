@@ -21,6 +21,7 @@ from more_agent.llm import constants as C
 from more_agent.llm.client import ChatRequest, Generation
 from more_agent.llm.config import LLMConfig, StructuredOutput
 from more_agent.llm.limits import MAX_ERROR_CHARS, clip
+from more_agent.llm.usage import token_count
 from more_agent.redaction import has_credentials, redact, register_secret
 from more_agent.llm.errors import (
     LLMAuthError,
@@ -28,6 +29,7 @@ from more_agent.llm.errors import (
     LLMConfigError,
     LLMConnectionError,
     LLMRateLimited,
+    LLMResponseTooLarge,
     LLMServerError,
     LLMTimeout,
     LLMTransportError,
@@ -146,8 +148,11 @@ class OpenAIBackend:
         if self._sdk is None:
             import openai
 
+            from more_agent.llm.http import bounded_client
+
             self._sdk = openai.OpenAI(
-                api_key=self._api_key, base_url=self.base_url, timeout=self.timeout_s, max_retries=0
+                api_key=self._api_key, base_url=self.base_url, timeout=self.timeout_s, max_retries=0,
+                http_client=bounded_client(self.timeout_s),
             )
         return self._sdk
 
@@ -195,14 +200,16 @@ class OpenAIBackend:
         return Generation(
             text=text,
             model=resp.model or self.model,
-            prompt_tokens=usage.prompt_tokens if usage else 0,
-            completion_tokens=usage.completion_tokens if usage else 0,
+            prompt_tokens=token_count(getattr(usage, "prompt_tokens", 0)),
+            completion_tokens=token_count(getattr(usage, "completion_tokens", 0)),
             attempts=1,
         )
 
     def generate(self, request: ChatRequest) -> Generation:
         """Answer ``request``, retrying transient failures; raises the typed error of the last one."""
         import openai
+
+        from more_agent.llm.http import BodyTooLarge
 
         attempts = retries = 0
         while True:
@@ -226,6 +233,8 @@ class OpenAIBackend:
                     f"{self.base_url} rejected response_format {schema_format}: {e}", status_code=e.status_code,
                     attempts=attempts,
                 ) from None
+            except BodyTooLarge as e:
+                raise LLMResponseTooLarge(f"{self.base_url}: {e}; not retried", attempts=attempts) from None
             except openai.BadRequestError as e:
                 raise LLMBadRequest(
                     f"bad request to {self.model}: {e}", status_code=e.status_code, attempts=attempts
@@ -248,7 +257,8 @@ class OpenAIBackend:
                 )
             except openai.APITimeoutError:
                 error = LLMTimeout(
-                    f"{self.model} at {self.base_url} did not answer within {self.timeout_s:g} s", attempts=attempts
+                    f"{self.model} at {self.base_url} did not answer within {self.timeout_s:g} s (the whole request)",
+                    attempts=attempts,
                 )
             except openai.APIConnectionError as e:
                 error = LLMConnectionError(f"cannot reach {self.base_url}: {e}", attempts=attempts)

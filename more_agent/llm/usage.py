@@ -27,6 +27,9 @@ PRICES: Mapping[str, ModelPrice] = {
     "o3-mini": ModelPrice(input_per_m=1.10, output_per_m=4.40),
 }
 
+MAX_TOKENS_PER_CALL = 10_000_000
+"""Largest token count one answer's usage may report (context windows are far smaller)."""
+
 _SNAPSHOT_SUFFIX = re.compile(r"-\d{4}-\d{2}-\d{2}$|-\d{4}$")
 
 
@@ -37,6 +40,19 @@ def price_of(model: str, extra: Mapping[str, ModelPrice] | None = None) -> Model
         if name in table:
             return table[name]
     return None
+
+
+def token_count(value: object) -> int:
+    """A server's token count as this project counts it: an integer in [0, MAX_TOKENS_PER_CALL], else 0.
+
+    A server has sent negative counts (a cost of -$752), 1e300 and null; none of them is a count,
+    so the answer is kept and its usage counted as unknown (0), never as a number that cannot be.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return 0
+    if isinstance(value, float) and not value.is_integer():
+        return 0
+    return int(value) if 0 <= value <= MAX_TOKENS_PER_CALL else 0
 
 
 def cost_usd(price: ModelPrice, prompt_tokens: int, completion_tokens: int) -> float:

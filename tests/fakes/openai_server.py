@@ -3,7 +3,8 @@
 Each POST to ``/v1/chat/completions`` takes the next script item: a :class:`Reply` (text answer with
 usage), a :class:`Status` (HTTP error, optional ``retry-after``), a :class:`Delay` (wait, then serve
 another item; makes clients time out), :class:`Raw` (any body) or :class:`Close` (drop the connection
-without answering) or :class:`Reset` (abort the connection with a TCP reset).
+without answering) or :class:`Reset` (abort the connection with a TCP reset), :class:`Trickle` (a
+body, or headers and body, one byte at a time) or :class:`Huge` (a body of any size, streamed).
 A plain string in a script is a Reply. Requests are recorded in ``server.requests``. Binds to
 127.0.0.1 on a free port; use it as a context manager::
 
@@ -30,8 +31,9 @@ class Reply:
     """A successful chat completion with this text and usage."""
 
     text: str
-    prompt_tokens: int = 100
-    completion_tokens: int = 20
+    prompt_tokens: int | float | None = 100
+    completion_tokens: int | float | None = 20
+    """Usage as sent: a hostile server's may be negative, 1e300 or null."""
     model: str | None = None
     """Model name in the response; None echoes the requested model."""
 
@@ -72,7 +74,25 @@ class Reset:
     """Abort the connection with a TCP reset (``SO_LINGER`` 0): the client sees ECONNRESET."""
 
 
-ScriptItem = Reply | Status | Delay | Raw | Close | Reset
+@dataclass(frozen=True)
+class Trickle:
+    """Serve ``then`` one byte every ``interval_s`` seconds: only its body, or (``headers``) the whole response."""
+
+    then: Reply
+    interval_s: float = 1.0
+    headers: bool = False
+
+
+@dataclass(frozen=True)
+class Huge:
+    """A 200 response whose body is ``size`` bytes of JSON-looking padding, streamed in 64 kB pieces
+    (never held in memory); ``declare_length=False`` sends it without a Content-Length (close-delimited)."""
+
+    size: int
+    declare_length: bool = True
+
+
+ScriptItem = Reply | Status | Delay | Raw | Close | Reset | Trickle | Huge
 
 
 @dataclass(frozen=True)
@@ -185,7 +205,11 @@ class _Handler(BaseHTTPRequestHandler):
             self.close_connection = True
 
     def _serve(self, item: ScriptItem, body: dict[str, Any]) -> None:
-        if isinstance(item, Delay):
+        if isinstance(item, Trickle):
+            self._trickle(item, body)
+        elif isinstance(item, Huge):
+            self._huge(item)
+        elif isinstance(item, Delay):
             self.fake._stopped.wait(item.seconds)
             self._serve(item.then, body)
         elif isinstance(item, Raw):
@@ -199,23 +223,54 @@ class _Handler(BaseHTTPRequestHandler):
             headers = {"retry-after": f"{item.retry_after:g}"} if item.retry_after is not None else {}
             self._send_json(item.code, {"error": {"message": item.message, "type": "fake", "code": None}}, headers)
         else:
-            self._send_json(
-                200,
-                {
-                    "id": f"chatcmpl-fake-{len(self.fake.requests)}",
-                    "object": "chat.completion",
-                    "created": int(time.time()),
-                    "model": item.model or body.get("model", "fake-model"),
-                    "choices": [
-                        {"index": 0, "message": {"role": "assistant", "content": item.text}, "finish_reason": "stop"}
-                    ],
-                    "usage": {
-                        "prompt_tokens": item.prompt_tokens,
-                        "completion_tokens": item.completion_tokens,
-                        "total_tokens": item.prompt_tokens + item.completion_tokens,
-                    },
-                },
-            )
+            self._send_json(200, self._completion(item, body))
+
+    def _completion(self, item: Reply, body: dict[str, Any]) -> dict[str, Any]:
+        """The chat-completion JSON of ``item`` (usage sent as given, however wrong)."""
+        p, c = item.prompt_tokens, item.completion_tokens
+        return {
+            "id": f"chatcmpl-fake-{len(self.fake.requests)}",
+            "object": "chat.completion",
+            "created": int(time.time()),
+            "model": item.model or body.get("model", "fake-model"),
+            "choices": [{"index": 0, "message": {"role": "assistant", "content": item.text}, "finish_reason": "stop"}],
+            "usage": {"prompt_tokens": p, "completion_tokens": c,
+                      "total_tokens": None if p is None or c is None else p + c},
+        }
+
+    def _trickle(self, item: Trickle, body: dict[str, Any]) -> None:
+        data = json.dumps(self._completion(item.then, body)).encode()
+        head = (f"HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nContent-Length: {len(data)}\r\n\r\n").encode()
+        self.close_connection = True
+        try:
+            if not item.headers:
+                self.wfile.write(head)
+                self.wfile.flush()
+            for i in range(len(data) + (len(head) if item.headers else 0)):
+                if self.fake._stopped.wait(item.interval_s):
+                    return
+                byte = (head + data)[i:i + 1] if item.headers else data[i:i + 1]
+                self.wfile.write(byte)
+                self.wfile.flush()
+        except (BrokenPipeError, ConnectionResetError):
+            pass
+
+    def _huge(self, item: Huge) -> None:
+        self.close_connection = True
+        piece = b" " * 65536
+        try:
+            self.send_response(200)
+            self.send_header("Content-Type", "application/json")
+            if item.declare_length:
+                self.send_header("Content-Length", str(item.size))
+            self.end_headers()
+            sent = 0
+            while sent < item.size and not self.fake._stopped.is_set():
+                chunk = piece[: item.size - sent]
+                self.wfile.write(chunk)
+                sent += len(chunk)
+        except (BrokenPipeError, ConnectionResetError):
+            pass
 
     def do_POST(self) -> None:
         raw = self.rfile.read(int(self.headers.get("Content-Length", 0)))
