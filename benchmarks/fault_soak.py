@@ -9,6 +9,15 @@ object: episodes run, faults injected by kind, kills, duplicates (must be 0), lo
 retryable errors left after one --retry-errors pass (0 expected), peak cache size, wall time.
 
     python benchmarks/fault_soak.py --episodes 200 --workers 2 --fault-rate 0.05 --kills 2
+
+With ``--cases`` it runs the hostile cases of ``benchmarks/hostile_cases.py`` instead (trickling and
+flooding servers, folders that lie, numbers that cannot be, signals), one CLI subprocess each, and
+prints a Markdown table of cases x outcome (traceback / wrong exit / data / secret / terminal) and
+one JSON line of the counts. ``--python`` and ``--repo`` measure another checkout's code, e.g.
+main's, read-only (its folders are only read; every case writes under a temporary folder)::
+
+    python benchmarks/fault_soak.py --cases
+    python benchmarks/fault_soak.py --cases --python /work/main/.venv/bin/python --repo /work/main
 """
 
 from __future__ import annotations
@@ -88,14 +97,38 @@ def run_killed(cmd: list[str], env: dict[str, str], jsonl: Path, kill_at: int | 
     return proc.returncode
 
 
+def hostile_cases(python: str, repo: Path, only: str | None) -> None:
+    """Run the hostile cases against ``repo``'s code; print the table and the counts."""
+    from benchmarks.hostile_cases import CASES, COLUMNS, run_case, table
+
+    results = []
+    for case in CASES:
+        if only and only not in case.name:
+            continue
+        result = run_case(case, python=python, repo=repo, kitchen=KITCHEN)
+        print(json.dumps({k: v for k, v in result.items()}, default=str), file=sys.stderr, flush=True)
+        results.append(result)
+    print(table(results))
+    print(json.dumps({"benchmark": "fault_soak_cases", "repo": str(repo), "cases": len(results),
+                      "failed_cases": sum(any(r[c] for c in COLUMNS) for r in results),
+                      **{c: sum(bool(r[c]) for r in results) for c in COLUMNS}}), flush=True)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--cases", action="store_true", help="run the hostile cases and print their table instead")
+    p.add_argument("--python", default=sys.executable, help="with --cases: the interpreter to run the CLI with")
+    p.add_argument("--repo", type=Path, default=REPO, help="with --cases: the checkout whose code runs")
+    p.add_argument("--only", help="with --cases: only the cases whose name holds this text")
     p.add_argument("--episodes", type=int, default=200)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--fault-rate", type=float, default=0.05, help="share of LLM requests that start a fault")
     p.add_argument("--kills", type=int, default=2, help="kill -9 the eval this many times at random progress")
     p.add_argument("--seed", type=int, default=0)
     a = p.parse_args()
+    if a.cases:
+        hostile_cases(a.python, a.repo.resolve(), a.only)
+        return
     rng = random.Random(a.seed)
     responder = FaultyResponder(quick_brain, rate=a.fault_rate, seed=a.seed, slow_s=1.5, oversize_chars=5_000_000)
     start = time.perf_counter()

@@ -28,6 +28,7 @@ from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
 from more_agent.redaction import redact
+from more_agent.safe_files import DISK_FULL_ERRNOS
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
@@ -143,6 +144,7 @@ def run_episode(
     except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
         record.error = redact(f"{type(e).__name__}: {e}")
         record.traceback = redact(traceback.format_exc())
+        record.retryable = isinstance(e, OSError) and e.errno in DISK_FULL_ERRNOS  # free space, run again
     if world is not None and goals is not None and planner is not None:
         _finish(record, goals.check(world), scope, planner)
     record.failure = classify_failure(record, world)

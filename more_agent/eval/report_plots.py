@@ -10,6 +10,7 @@ Every function takes plain records and writes one file; systems are ordered as i
 
 from __future__ import annotations
 
+import io
 import re
 from collections import Counter
 from collections.abc import Sequence
@@ -23,6 +24,7 @@ import numpy as np  # noqa: E402
 
 from more_agent.eval.metrics import METRIC_NAMES, by_system, by_task, group_by, system_label  # noqa: E402
 from more_agent.records import EpisodeRecord  # noqa: E402
+from more_agent.safe_files import write_atomic  # noqa: E402
 
 PLOT_FILES = {
     "metrics": "plot_metrics.png",
@@ -37,10 +39,12 @@ _COLOURS = plt.get_cmap("tab10")
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
+    buf = io.BytesIO()
     try:
-        fig.savefig(path, dpi=DPI, bbox_inches="tight")
+        fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
     finally:
         plt.close(fig)
+    write_atomic(path, buf.getvalue(), durable=False)
     return path
 
 
@@ -53,7 +57,8 @@ def plot_metrics(records: Sequence[EpisodeRecord], path: Path) -> Path:
     for ax, metric in zip(axes.flat, METRIC_NAMES):
         est = [getattr(systems[n], metric) for n in names]
         mean = np.array([100 * e.mean for e in est])
-        err = np.array([[100 * (e.mean - e.low) for e in est], [100 * (e.high - e.mean) for e in est]])
+        # clipped at 0: a percentile bootstrap's interval can miss the mean of a tiny, skewed sample
+        err = np.clip([[100 * (e.mean - e.low) for e in est], [100 * (e.high - e.mean) for e in est]], 0, None)
         ax.barh(y, mean, xerr=err, color=[_COLOURS(i % 10) for i in range(len(names))], capsize=3, alpha=0.85)
         for yi, m, e in zip(y, mean, est):
             ax.text(min(100 * e.high + 1.5, 92), yi, f"{m:.0f}", va="center", fontsize=8)

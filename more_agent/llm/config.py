@@ -98,6 +98,10 @@ class LLMConfig(BaseModel):
     )
     cache_mode: CacheMode = Field(default=CacheMode.ON, description="Response cache use: on, refresh, off, replay.")
     cache_path: Path = Field(default=C.DEFAULT_CACHE_PATH, description="sqlite file of the response cache.")
+    cache_busy_timeout_s: float = Field(
+        default=C.CACHE_BUSY_TIMEOUT_S, ge=0, le=MAX_TIMEOUT_S,
+        description="How long to wait for another process's lock on the cache before the call fails (transient).",
+    )
     prices: dict[str, ModelPrice] = Field(
         default_factory=dict, description="Extra or overriding prices per model name (see more_agent.llm.usage)."
     )

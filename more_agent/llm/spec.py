@@ -92,7 +92,7 @@ def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:
     cache = None
     if config.cache_mode is not CacheMode.OFF:
         check_cache_path(config.cache_path, write=config.cache_mode is not CacheMode.REPLAY)
-        cache = ResponseCache(config.cache_path)
+        cache = ResponseCache(config.cache_path, busy_timeout_s=config.cache_busy_timeout_s)
     return ChatClient(
         make_backend(spec, config),
         cache=cache,

@@ -107,7 +107,7 @@ def test_cli_eval_then_report(tmp_path: Path) -> None:
     args = ["eval", "--tasks", "a,bad", "--planner", "oracle", "--seeds", "2", "--no-progress"]
     args += ["--episode-fn", "tests.eval.fake_episodes:raising_episode", "--out", str(tmp_path / "run")]
     result = runner.invoke(app, args)
-    assert result.exit_code == 0, result.output
+    assert result.exit_code == 1, result.output  # episodes that raised: a system error (exit-status contract)
     assert "| oracle | 4 | 2 | 2 |" in result.output
     assert {p.name for p in (tmp_path / "run").iterdir()} >= {"episodes.jsonl", "run.json", "summary.md", "summary.csv", "report.html"}
     again = runner.invoke(app, args)
