@@ -26,6 +26,8 @@ def unknown_name_error(kind: str, name: str, candidates: Iterable[str]) -> UserE
 
 def check_writable_dir(path: Path, what: str = "--out") -> None:
     """Raise a UserError unless ``path`` is, or can be created as, a writable directory."""
+    if path.is_symlink() and not path.exists():
+        raise UserError(f"{what} {path} is a symlink to nothing (dangling, or a loop)")
     if path.exists() and not path.is_dir():
         raise UserError(f"{what} {path} exists and is not a directory")
     existing = next((p for p in (path, *path.parents) if p.exists()), Path("."))

@@ -94,10 +94,13 @@ def iter_ray(
     ray = import_ray()
     started = False
     if not ray.is_initialized():
-        if address == "local":
-            ray.init(num_cpus=num_cpus, include_dashboard=False, log_to_driver=False)
-        else:
-            ray.init(address=address, log_to_driver=False)
+        try:
+            if address == "local":
+                ray.init(num_cpus=num_cpus, include_dashboard=False, log_to_driver=False)
+            else:
+                ray.init(address=address, log_to_driver=False)
+        except (ConnectionError, ValueError, RuntimeError) as e:
+            raise UserError(f"cannot start or reach Ray at {address!r}: {str(e).splitlines()[0][:200]}") from None
         started = True
     try:
         limiter = RayLimiter.create(max_concurrent_llm) if max_concurrent_llm else None

@@ -145,10 +145,12 @@ def read_records(path: Path, *, repair: bool = False) -> list[EpisodeRecord]:
     data = read_bounded(path, what="run records", max_bytes=MAX_STORE_BYTES).encode("utf-8")
     records, good_end = _parse_lines(data, path)
     if repair and good_end < len(data):
-        with open(path, "r+b") as fh:
-            fh.truncate(good_end)
-            fh.flush()
-            os.fsync(fh.fileno())
+        fd = open_nofollow(path, os.O_RDWR)  # never truncate a symlink's target
+        try:
+            os.ftruncate(fd, good_end)
+            os.fsync(fd)
+        finally:
+            os.close(fd)
     return records
 
 
