@@ -20,9 +20,10 @@ from __future__ import annotations
 import functools
 import logging
 import sys
+import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Annotated, TypeVar
+from typing import Annotated, TextIO, TypeVar
 
 import typer
 from rich.console import Console
@@ -74,13 +75,21 @@ class _SafeStderrHandler(logging.Handler):
             self.handleError(record)
 
 
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: TextIO | None = None, line: str | None = None) -> None:
+    """Python warnings on stderr without escape sequences (a library warning may quote a scene name)."""
+    (file or sys.stderr).write(for_terminal(warnings.formatwarning(message, category, filename, lineno, line)))
+
+
 def _install_log_handler() -> None:
-    """Route the package's warnings through :class:`_SafeStderrHandler` (once per process)."""
+    """Route the package's log lines through :class:`_SafeStderrHandler` (once per process), and
+    print Python warnings as safely."""
     logger = logging.getLogger("more_agent")
     if not any(isinstance(h, _SafeStderrHandler) for h in logger.handlers):
         handler = _SafeStderrHandler(logging.WARNING)
         logger.addHandler(handler)
         logger.propagate = False
+    warnings.showwarning = _show_warning
 
 
 def print_error(message: str) -> None:
