@@ -10,7 +10,8 @@ Files: ``.json`` (Spark-DSG's JSON), ``.sparkdsg`` / ``.bson`` (its binary forma
 Import (``from_spark_dsg``, ``load_spark_dsg``), for graphs as Hydra writes them: an object's category
 is, in order, our metadata, the user's label map (semantic label -> name), the graph's OBJECTS label
 space; places become the navigation graph (edge weights as given, else the places' distance), rooms the regions;
-a place without a room joins a region per connected component of room-less places; an object's region is
+a place without a room joins the room closest along the place graph, and places no room reaches form a region
+per connected component; an object's region is
 its parent room, its parent place's, else the nearest place's. Relations come from our metadata, else from
 the boxes (``scene_graph.relations``). Frontier places (Hydra's ``real_place = False``) become frontiers.
 """
@@ -193,9 +194,15 @@ def _regions(G: Any, real: list[Any], index: dict[int, int], xy: np.ndarray,
     for n in real:
         room = _parent_in(n, rooms)
         node_region.append(names[room.id.value] if room is not None else None)
-    loose = nx.Graph()
-    loose.add_nodes_from(i for i, r in enumerate(node_region) if r is None)
-    loose.add_edges_from((a, b) for a, b in edges if node_region[a] is None and node_region[b] is None)
+    places = nx.Graph()
+    places.add_nodes_from(range(len(real)))
+    places.add_weighted_edges_from((a, b, float(np.linalg.norm(xy[a] - xy[b]))) for a, b in edges)
+    roomed = {i for i, r in enumerate(node_region) if r is not None}
+    if roomed:  # a room-less place joins the room it is closest to along the place graph
+        _, paths = nx.multi_source_dijkstra(places, roomed)
+        for i, path in paths.items():
+            node_region[i] = node_region[path[0]]
+    loose = places.subgraph(i for i, r in enumerate(node_region) if r is None)
     for k, comp in enumerate(sorted(nx.connected_components(loose), key=min)):
         for i in comp:
             node_region[i] = f"region_{len(rooms) + k}"
