@@ -2,7 +2,8 @@
 
 Prints the chosen subpolicy with its arguments and the filtered scene, or with ``--json`` the whole
 :class:`~more_agent.service.decision.Decision`. Without an LLM it says how to configure one (exit 2):
-the privileged planners never run on real data.
+the privileged planners never run on real data. An LLM that fails: one error line, exit 75 when it is
+transient (unreachable, timeout, 5xx, 429), 1 otherwise.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import typer
 from pydantic import TypeAdapter, ValidationError
 from rich.text import Text
 
-from more_agent.commands._common import console, user_errors_exit_2
+from more_agent.commands._common import EXIT_FAILED, EXIT_RETRYABLE, console, print_error, user_errors_exit_2
 from more_agent.errors import UserError
 from more_agent.records import ActionRecord
 
@@ -44,6 +45,7 @@ def plan(
     """One MORE decision: room labels, filtered scene, and the next subpolicy with its arguments."""
     from more_agent.errors import unknown_name_error
     from more_agent.interop.graph_file import read_graph, read_label_map
+    from more_agent.llm.errors import LLMAuthError, LLMBadRequest, LLMError, LLMTransportError
     from more_agent.service.decision import LLM_PLANNERS, decide, planner_clients
 
     if planner not in LLM_PLANNERS:
@@ -51,7 +53,12 @@ def plan(
     clients = planner_clients(llm)  # no LLM: says how to configure one, before reading anything
     scene_graph = read_graph(graph, read_label_map(label_map) if label_map else None)
     actions = read_history(history) if history is not None else []
-    decision = decide(scene_graph, task, actions, clients, planner=planner)
+    try:
+        decision = decide(scene_graph, task, actions, clients, planner=planner)
+    except LLMError as e:
+        print_error(f"LLM error ({type(e).__name__}): {e}")
+        transient = isinstance(e, LLMTransportError) and not isinstance(e, (LLMAuthError, LLMBadRequest))
+        raise typer.Exit(code=EXIT_RETRYABLE if transient else EXIT_FAILED) from None
     if as_json:
         print(decision.model_dump_json(indent=2))
         return
