@@ -10,7 +10,8 @@ and Spark-DSG import time. Prints one JSON object.
    256x256 stream, in MCAP and in sqlite3.
 3. ``compare_graphs`` of the live robot's last graph and the ingested one: the round trip's errors.
 4. The bag's size per 100 frames (MCAP, uncompressed; sqlite3).
-5. Spark-DSG: the episode's graph saved as JSON and binary, and (``--hydra``) a Hydra output, imported.
+5. Spark-DSG: the episode's graph saved as JSON and binary, a synthetic Hydra-style graph (a grid of
+   places, rooms, objects) and (``--hydra``) a Hydra output, imported.
 """
 
 from __future__ import annotations
@@ -47,12 +48,51 @@ def _import_s(path: Path, label_map: dict[int, str] | None = None, repeats: int 
             "regions": len(graph.regions), "bytes": path.stat().st_size}
 
 
+def synthetic_hydra_graph(side: int, path: Path) -> Path:
+    """A Hydra-style graph saved to ``path``: a side x side grid of places 0.5 m apart, a room per 10 x 10
+    block, an object (semantic label 0..9) on every fourth place; no MORE metadata."""
+    import numpy as np
+    import spark_dsg as dsg
+
+    G = dsg.DynamicSceneGraph()
+    G.set_labelspace(dsg.Labelspace({k: f"class_{k}" for k in range(10)}), dsg.DsgLayers.OBJECTS)
+    rooms: dict[tuple[int, int], object] = {}
+    for i in range(side):
+        for j in range(side):
+            place = dsg.PlaceNodeAttributes()
+            place.position = np.array([0.5 * i, 0.5 * j, 0.0])
+            sym = dsg.NodeSymbol("p", i * side + j)
+            G.add_node(dsg.DsgLayers.PLACES, sym, place)
+            if i:
+                G.insert_edge(dsg.NodeSymbol("p", (i - 1) * side + j), sym)
+            if j:
+                G.insert_edge(dsg.NodeSymbol("p", i * side + j - 1), sym)
+            block = (i // 10, j // 10)
+            if block not in rooms:
+                room = dsg.RoomNodeAttributes()
+                room.position = np.array([5.0 * block[0] + 2.5, 5.0 * block[1] + 2.5, 0.0])
+                rooms[block] = dsg.NodeSymbol("R", len(rooms))
+                G.add_node(dsg.DsgLayers.ROOMS, rooms[block], room)
+            G.insert_edge(rooms[block], sym)
+            if (i * side + j) % 4 == 0:
+                obj = dsg.ObjectNodeAttributes()
+                obj.semantic_label = (i + j) % 10
+                obj.position = np.array([0.5 * i, 0.5 * j, 0.5])
+                obj.bounding_box = dsg.BoundingBox(np.full(3, 0.3, dtype=np.float32), obj.position.astype(np.float32))
+                osym = dsg.NodeSymbol("O", i * side + j)
+                G.add_node(dsg.DsgLayers.OBJECTS, osym, obj)
+                G.insert_edge(sym, osym)
+    G.save(str(path), include_mesh=False)
+    return path
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--task", default="putting_shopping_away")
     parser.add_argument("--scene", default="Rs_int")
     parser.add_argument("--seed", type=int, default=3)
     parser.add_argument("--hydra", type=Path, help="A Hydra / Spark-DSG JSON graph (uHumans2 apartment labels).")
+    parser.add_argument("--synthetic-side", type=int, default=120, help="Places per side of the synthetic graph.")
     args = parser.parse_args()
     spec = EpisodeSpec(task=args.task, scene=args.scene, seed=args.seed, planner="grounded")
     tmp = Path(tempfile.mkdtemp(prefix="ros_interop_"))
@@ -88,6 +128,8 @@ def main() -> None:
             "spark_dsg_import": {"episode_json": _import_s(tmp / "graph.json"),
                                  "episode_binary": _import_s(tmp / "graph.sparkdsg")},
         }
+        large = synthetic_hydra_graph(args.synthetic_side, tmp / "synthetic.json")
+        out["spark_dsg_import"][f"synthetic_{args.synthetic_side}x{args.synthetic_side}"] = _import_s(large, repeats=1)
         if args.hydra is not None:
             out["spark_dsg_import"]["hydra"] = _import_s(args.hydra, HYDRA_APARTMENT_LABELS)
         print(json.dumps(out, indent=2))

@@ -13,7 +13,7 @@ space; places become the navigation graph (edge weights as given, else the place
 a place without a room joins the room closest along the place graph, and places no room reaches form a region
 per connected component; an object's region is
 its parent room, its parent place's, else the nearest place's. Relations come from our metadata, else from
-the boxes (``scene_graph.relations``). Frontier places (Hydra's ``real_place = False``) become frontiers.
+the boxes (``scene_graph.relations``, within each region). Frontier places (Hydra's ``real_place = False``) become frontiers.
 """
 
 from __future__ import annotations
@@ -153,15 +153,17 @@ def from_spark_dsg(G: Any, label_map: Mapping[int, str] | None = None) -> SceneG
     real = [n for n in place_nodes if getattr(n.attributes, "real_place", True)]
     index = {n.id.value: i for i, n in enumerate(real)}
     xy = np.array([n.attributes.position[:2] for n in real], dtype=float).reshape(-1, 2)
-    edges, weights, doors = [], [], []
-    place_edges = sorted(G.get_layer(PLACES).edges if place_nodes else [], key=lambda e: _meta(e.info).get("order", 0))
-    for e in place_edges:
+    edges, given, doors = [], [], []
+    metas = [(e, _meta(e.info)) for e in (G.get_layer(PLACES).edges if place_nodes else [])]
+    for e, meta in sorted(metas, key=lambda em: em[1].get("order", 0)):
         if e.source in index and e.target in index:
-            a, b = index[e.source], index[e.target]
-            edges.append((a, b))
-            weights.append(float(e.info.weight) if e.info.weighted else float(np.linalg.norm(xy[a] - xy[b])))
-            doors.append(bool(_meta(e.info).get("door", False)))
-    node_region, regions = _regions(G, real, index, xy, edges)
+            edges.append((index[e.source], index[e.target]))
+            given.append(float(e.info.weight) if e.info.weighted else np.nan)
+            doors.append(bool(meta.get("door", False)))
+    pairs = np.array(edges, dtype=np.int64).reshape(-1, 2)
+    lengths = np.linalg.norm(xy[pairs[:, 0]] - xy[pairs[:, 1]], axis=1)
+    weights = np.where(np.isnan(given), lengths, given) if edges else lengths
+    node_region, regions = _regions(G, real, xy, pairs, lengths)
     objects = _objects(G, label_map, real, index, xy, node_region)
     relations = _relations(G, objects)
     frontiers = [n.attributes.position[:2] for n in place_nodes if not getattr(n.attributes, "real_place", True)]
@@ -170,7 +172,7 @@ def from_spark_dsg(G: Any, label_map: Mapping[int, str] | None = None) -> SceneG
     return SceneGraph(
         step=int((G.metadata.get().get(KEY) or {}).get("step", 0)), robot=robot, regions=regions, objects=objects,
         relations=relations,
-        nav=NavGraphData(node_xy=xy, edges=np.array(edges, dtype=np.int64).reshape(-1, 2), weights=weights,
+        nav=NavGraphData(node_xy=xy, edges=pairs, weights=weights,
                          door_edges=doors, node_region=node_region),
     )
 
@@ -179,8 +181,8 @@ def _parent_in(node: Any, layer_nodes: Mapping[int, Any]) -> Any:
     return next((layer_nodes[p] for p in node.parents() if p in layer_nodes), None) if node.has_parent() else None
 
 
-def _regions(G: Any, real: list[Any], index: dict[int, int], xy: np.ndarray,
-             edges: list[tuple[int, int]]) -> tuple[list[str | None], dict[str, RegionNode]]:
+def _regions(G: Any, real: list[Any], xy: np.ndarray, edges: np.ndarray,
+             lengths: np.ndarray) -> tuple[list[str | None], dict[str, RegionNode]]:
     """Region id per place and the regions: rooms, then one per component of room-less places."""
     rooms = {n.id.value: n for n in G.get_layer(ROOMS).nodes} if G.has_layer(ROOMS) else {}
     names, room_labels, frontiers = {}, {}, {}
@@ -196,7 +198,7 @@ def _regions(G: Any, real: list[Any], index: dict[int, int], xy: np.ndarray,
         node_region.append(names[room.id.value] if room is not None else None)
     places = nx.Graph()
     places.add_nodes_from(range(len(real)))
-    places.add_weighted_edges_from((a, b, float(np.linalg.norm(xy[a] - xy[b]))) for a, b in edges)
+    places.add_weighted_edges_from(zip(edges[:, 0].tolist(), edges[:, 1].tolist(), lengths.tolist()))
     roomed = {i for i, r in enumerate(node_region) if r is not None}
     if roomed:  # a room-less place joins the room it is closest to along the place graph
         _, paths = nx.multi_source_dijkstra(places, roomed)
@@ -206,13 +208,16 @@ def _regions(G: Any, real: list[Any], index: dict[int, int], xy: np.ndarray,
     for k, comp in enumerate(sorted(nx.connected_components(loose), key=min)):
         for i in comp:
             node_region[i] = f"region_{len(rooms) + k}"
+    members: dict[str, list[int]] = {rid: [] for rid in names.values()}
+    for i, rid in enumerate(node_region):
+        members.setdefault(rid, []).append(i)  # type: ignore[arg-type] - every place has a region by now
+    room_of = {rid: rooms[v] for v, rid in names.items()}
     regions = {}
-    for rid in sorted(set(r for r in node_region if r is not None) | set(names.values())):
-        members = [i for i, r in enumerate(node_region) if r == rid]
-        room = next((n for v, n in rooms.items() if names[v] == rid), None)
-        centroid = xy[members].mean(0) if members else np.asarray(room.attributes.position[:2])
+    for rid in sorted(members):
+        mine = members[rid]
+        centroid = xy[mine].mean(0) if mine else np.asarray(room_of[rid].attributes.position[:2])
         regions[rid] = RegionNode(id=rid, room_label=room_labels.get(rid), centroid=tuple(map(float, centroid)),
-                                  nav_nodes=members, frontiers=frontiers.get(rid, []))
+                                  nav_nodes=mine, frontiers=frontiers.get(rid, []))
     return node_region, regions
 
 
@@ -268,11 +273,17 @@ def _relations(G: Any, objects: dict[str, ObjectNode]) -> list[Relation]:
     ours = sorted((m.get("order", 0), m["relation"]) for m in metas if m.get("relation"))
     if ours:
         return [Relation(subject=s, predicate=p, object=o) for _, (s, p, o) in ours if s in objects and o in objects]
-    placed = [o for o in objects.values() if not o.held and o.category != "door"]
-    lo = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
-    hi = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
-    return [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
-            for a, p, b in spatial_relations(lo, hi, tol_m=RELATION_TOL_M, inside_fraction=INSIDE_FRACTION)]
+    by_region: dict[str | None, list[ObjectNode]] = {}
+    for o in objects.values():
+        if not o.held and o.category != "door":
+            by_region.setdefault(o.region_id, []).append(o)
+    relations = []
+    for placed in by_region.values():  # per region: the pairs test is quadratic, and relations stay within rooms
+        lo = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
+        hi = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
+        relations += [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
+                      for a, p, b in spatial_relations(lo, hi, tol_m=RELATION_TOL_M, inside_fraction=INSIDE_FRACTION)]
+    return relations
 
 
 def _with_frontiers(regions: dict[str, RegionNode], frontiers: list[Any], xy: np.ndarray,

@@ -16,6 +16,8 @@ from more_agent.interop.compare import compare_graphs
 from more_agent.interop.ingest import ingest_bag, letters
 from tests.interop.bags import rewrite_bag
 
+pytestmark = pytest.mark.slow  # a recorded episode, ingested whole several times
+
 T = BagTopics()
 SHORT_S = 1.0
 """The broken bags keep the first second (10 frames) of the recording."""

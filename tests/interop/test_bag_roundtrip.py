@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from rosbags.rosbag2 import Reader, StoragePlugin
 from typer.testing import CliRunner
 
@@ -14,6 +15,8 @@ from more_agent.interop.bag_writer import POSE_TOPIC
 from more_agent.interop.compare import compare_graphs
 from more_agent.interop.ingest import ingest_bag
 from tests.interop.bags import rewrite_bag
+
+pytestmark = pytest.mark.slow  # a recorded episode, ingested whole several times
 
 ROUND_TRIP_TOL_M = 1e-9
 """Positions and boxes after the round trip (measured: 0.0; depth is float32 either way, poses float64)."""
@@ -59,3 +62,14 @@ def test_ingest_command_writes_graph_map_and_scene_text(recorded, tmp_path):
     assert "unknown_room_0: floor, " in scene and "fridge A [" in scene
     summary = json.loads((out / "ingest.json").read_text())
     assert summary["frames"] == recorded.frames and summary["objects"] == len(recorded.live.objects)
+
+
+def test_run_bag_refuses_an_existing_path_or_an_unknown_storage_before_any_work(tmp_path):
+    (tmp_path / "bag").mkdir()
+    result = CliRunner().invoke(app, ["run", "putting_shopping_away", "--planner", "oracle", "--out", str(tmp_path / "o"),
+                                      "--bag", str(tmp_path / "bag")])
+    assert result.exit_code == 2 and "exists; a bag is written to a new folder" in result.output
+    result = CliRunner().invoke(app, ["run", "putting_shopping_away", "--planner", "oracle", "--out", str(tmp_path / "o"),
+                                      "--bag", str(tmp_path / "new"), "--bag-storage", "rosbag1"])
+    assert result.exit_code == 2 and "use one of mcap, sqlite3" in result.output
+    assert not (tmp_path / "o" / "episode.json").exists() and not (tmp_path / "new").exists()
