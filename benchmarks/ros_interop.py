@@ -3,7 +3,7 @@ and Spark-DSG import time. Prints one JSON object.
 
 ``python benchmarks/ros_interop.py [--task putting_shopping_away --scene Rs_int --seed 3] [--hydra FILE.json]``
 
-1. The episode (grounded planner, no LLM) runs live three times: once plain (frames / wall time is the live
+1. The episode (grounded planner, no LLM) runs live: twice plain (frames / the faster wall time is the live
    simulator's rate: render, mapping, graph builds, planning and motion), then recording an MCAP and a
    sqlite3 bag.
 2. The bag goes through ``ingest`` (read, decode, pose lookup, fuse; then one graph build): frames/s of the
@@ -97,9 +97,11 @@ def main() -> None:
     spec = EpisodeSpec(task=args.task, scene=args.scene, seed=args.seed, planner="grounded")
     tmp = Path(tempfile.mkdtemp(prefix="ros_interop_"))
     try:
-        t = time.perf_counter()
-        run_episode(spec)
-        live_s = time.perf_counter() - t
+        live_s = float("inf")
+        for _ in range(2):  # the first run also pays imports and compiled kernels' loading
+            t = time.perf_counter()
+            run_episode(spec)
+            live_s = min(live_s, time.perf_counter() - t)
         bags = {}
         for storage in ("mcap", "sqlite3"):
             planner = make_planner("grounded", None)
