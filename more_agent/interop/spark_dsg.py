@@ -18,7 +18,10 @@ the boxes (``scene_graph.relations``, within each region). Frontier places (Hydr
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import os
+import sys
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -127,13 +130,27 @@ def load_spark_dsg(path: Path, label_map: Mapping[int, str] | None = None) -> Sc
     """Read a Spark-DSG file (JSON or binary) into MORE's scene graph (``from_spark_dsg``)."""
     dsg = _dsg()
     try:
-        G = dsg.DynamicSceneGraph.load(str(path))
+        with _stdout_to_stderr():
+            G = dsg.DynamicSceneGraph.load(str(path))
     except Exception as e:  # noqa: BLE001 - the bindings raise RuntimeError / ValueError for bad files
         raise SparkDsgError(f"cannot read {path} as a Spark-DSG graph: {type(e).__name__}: {e}") from None
     try:
         return from_spark_dsg(G, label_map)
     except ValidationError as e:
         raise SparkDsgError(f"{path}: the graph does not make a MORE scene graph: {str(e).splitlines()[0]}") from None
+
+
+@contextmanager
+def _stdout_to_stderr() -> Iterator[None]:
+    """Send what the C++ library prints (warnings about old encodings) to stderr: stdout may carry JSON."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def _meta(attrs: Any) -> dict[str, Any]:

@@ -4,6 +4,8 @@ an LLM, how to configure one; never a privileged planner."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import pytest
 from typer.testing import CliRunner
@@ -51,15 +53,20 @@ def test_plan_on_a_spark_dsg_file_prints_the_decision_as_json(tmp_path, llm_env)
     assert KEY not in result.output and not any(KEY.encode() in p.read_bytes() for p in tmp_path.rglob("*") if p.is_file())
 
 
-def test_plan_reads_the_hydra_apartment_with_a_label_map(tmp_path, llm_env):
+@pytest.mark.slow
+def test_plan_json_on_the_hydra_apartment_is_clean_json_on_stdout(tmp_path, llm_env):
+    """A real process: spark-dsg's C++ warning about the file's old encoding must not reach stdout."""
     label_map = tmp_path / "labels.json"
     label_map.write_text(json.dumps({str(k): v for k, v in APARTMENT_LABELS.items()}))
     with FakeOpenAIServer(responder=DecisionBrain(["table B"], "go_to_and_place_ontop", "table B")) as server:
         llm_env(server)
-        result = CliRunner().invoke(app, ["plan", "--graph", str(apartment(tmp_path)), "--label-map", str(label_map),
-                                          "--task", "put something on table B", "--llm", SPEC])
-    assert result.exit_code == 0, result.output
-    assert "go_to_and_place_ontop(kitchen_0, table B)" in result.output
+        done = subprocess.run([sys.executable, "-c", "from more_agent.cli import app; app()", "plan", "--graph",
+                               str(apartment(tmp_path)), "--label-map", str(label_map), "--task", "put it on table B",
+                               "--llm", SPEC, "--json"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    decision = json.loads(done.stdout)
+    assert (decision["skill"], decision["arguments"]) == ("go_to_and_place_ontop", ["kitchen_0", "table B"])
+    assert "outdated encoding" in done.stderr
 
 
 def test_plan_reads_our_own_graph_json(tmp_path, llm_env):
