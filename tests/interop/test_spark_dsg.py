@@ -12,7 +12,7 @@ from more_agent.interop.spark_dsg import SparkDsgError, from_spark_dsg, load_spa
 from more_agent.planners.language import scene_view
 from more_agent.planners.llm_planner import PLANNER_CONFIGS
 from more_agent.service.decision import decide
-from tests.fake_brain import DecisionBrain, clients
+from tests.fakes.decision_brain import DecisionBrain, clients
 from tests.fakes.openai_server import FakeOpenAIServer
 from tests.interop.hydra import APARTMENT_LABELS, apartment, kitchen_and_hall
 

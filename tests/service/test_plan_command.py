@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from more_agent.cli import app
 from more_agent.interop.spark_dsg import from_spark_dsg
 from more_agent.records import ActionRecord
-from tests.fake_brain import SPEC, DecisionBrain
+from tests.fakes.decision_brain import SPEC, DecisionBrain
 from tests.fakes.openai_server import FakeOpenAIServer, Status
 from tests.interop.hydra import APARTMENT_LABELS, apartment, kitchen_and_hall
 

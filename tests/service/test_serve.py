@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 from more_agent.cli import app as cli
 from more_agent.service.app import create_app
-from tests.fake_brain import DecisionBrain, clients
+from tests.fakes.decision_brain import DecisionBrain, clients
 from tests.fakes.openai_server import FakeOpenAIServer, Status
 from tests.interop.hydra import kitchen_and_hall
 
