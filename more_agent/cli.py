@@ -1,4 +1,4 @@
-"""The ``more-agent`` command: ``run | eval | tasks | scene | report | view``.
+"""The ``more-agent`` command: ``run | eval | tasks | scene | report | view | ingest | plan | serve``.
 
 Each command group lives in ``more_agent.commands.<name>``; this module only assembles them and
 turns a ``UserError`` into one message and exit status 2, never a traceback.
@@ -9,9 +9,12 @@ from __future__ import annotations
 import typer
 
 from more_agent.commands import eval as eval_cmd
+from more_agent.commands import ingest as ingest_cmd
+from more_agent.commands import plan as plan_cmd
 from more_agent.commands import report as report_cmd
 from more_agent.commands import run as run_cmd
 from more_agent.commands import scene as scene_cmd
+from more_agent.commands import serve as serve_cmd
 from more_agent.commands import tasks as tasks_cmd
 from more_agent.commands import view as view_cmd
 
@@ -26,5 +29,8 @@ app.command("run")(run_cmd.run)
 app.command("eval")(eval_cmd.eval_)
 app.command("report")(report_cmd.report)
 app.command("view")(view_cmd.view)
+app.command("ingest")(ingest_cmd.ingest)
+app.command("plan")(plan_cmd.plan)
+app.command("serve")(serve_cmd.serve)
 app.add_typer(tasks_cmd.app, name="tasks")
 app.add_typer(scene_cmd.app, name="scene")

@@ -15,10 +15,11 @@ LAYERS = (
     ("sim",),
     ("mapping",),
     ("scene_graph",),
+    ("interop",),
     ("llm",),
     ("viz",),
     ("planners",),
-    ("eval",),
+    ("eval", "service"),
     ("commands", "cli"),
 )
 """Bottom to top: each part may import its own layer's parts and those below."""

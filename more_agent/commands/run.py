@@ -10,8 +10,9 @@ one) is cleaned of that episode's files first.
 from __future__ import annotations
 
 import re
+from contextlib import nullcontext
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -25,9 +26,12 @@ from more_agent.commands._common import (
     episodes_exit_status,
     user_errors_exit_2,
 )
-from more_agent.errors import check_writable_dir
+from more_agent.errors import UserError, check_writable_dir
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import for_terminal
+
+if TYPE_CHECKING:
+    from more_agent.interop.bag_writer import BagRecorder
 
 NO_LLM_MESSAGE = (
     "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
@@ -51,6 +55,18 @@ def default_out_dir(task: str, scene: str | None, seed: int, planner: str) -> Pa
         scene = scenes[0] if scenes else "auto"
     name = re.sub(r"[^A-Za-z0-9_.\-]", "_", f"{task}-{Path(scene).stem}-{seed}-{planner}")
     return RUNS_DIR / name
+
+
+def open_bag_recorder(path: Path, storage: str) -> BagRecorder:
+    """A recorder for ``run --bag`` (not yet opened); a path that exists or a bad storage name is a UserError."""
+    from more_agent.interop.bag_writer import STORAGES, BagRecorder
+
+    if storage not in STORAGES:
+        raise UserError(f"--bag-storage {storage!r}: use one of {', '.join(STORAGES)}")
+    if path.exists():
+        raise UserError(f"--bag {path} exists; a bag is written to a new folder")
+    check_writable_dir(path.parent, "--bag")
+    return BagRecorder(path, storage=storage)  # type: ignore[arg-type]
 
 
 def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
@@ -92,6 +108,10 @@ def run(
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
     llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
     viewer: Annotated[bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")] = False,
+    bag: Annotated[Path | None, typer.Option(
+        help="Also record the robot's sensor stream as a ROS 2 bag folder (new path; 'ros' extra; docs/ros.md)."
+    )] = None,
+    bag_storage: Annotated[str, typer.Option(help="Storage of --bag: mcap or sqlite3.")] = "mcap",
 ) -> None:
     """Run one episode of TASK and write its record and map.
 
@@ -118,11 +138,15 @@ def run(
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
     spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors)
-    with locked_run_dir(out_dir), console.status(f"running {task} with planner {planner} ..."):
+    recorder = open_bag_recorder(bag, bag_storage) if bag is not None else None
+    with locked_run_dir(out_dir), console.status(f"running {task} with planner {planner} ..."), recorder or nullcontext():
         check_folder_for(out_dir, spec)
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
+            bag=recorder,
         )
     console.print(summary_table(record, out_dir))
+    if recorder is not None:
+        console.print(Text(f"bag: {bag} ({recorder.frames} frames, {bag_storage})"))
     if status := episodes_exit_status([record]):
         raise typer.Exit(code=status)

@@ -32,6 +32,7 @@ from more_agent.safe_files import DISK_FULL_ERRNOS
 from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
+    from more_agent.interop.bag_writer import BagRecorder
     from more_agent.sim.goals import GoalChecker, GoalStatus
     from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
@@ -88,6 +89,7 @@ def run_episode(
     strict: bool = False,
     planner: Planner | None = None,
     viewer: bool = False,
+    bag: BagRecorder | None = None,
 ) -> EpisodeRecord:
     """Run one episode of ``spec`` and return its record (also written under ``out_dir`` when given).
 
@@ -99,6 +101,7 @@ def run_episode(
     ``viewer`` (with ``out_dir``) saves what the episode viewer reads: frames and scene graphs, without
     the slow per-step graph pictures unless ``save_graph`` asks for them
     (``more_agent.eval.viewer.run_episode_with_viewer`` then writes the page).
+    ``bag`` (an open recorder) gets every frame the robot renders: ``run --bag`` (docs/ros.md).
     """
     from more_agent.llm.errors import LLMError
     from more_agent.sim.goals import GoalChecker
@@ -125,9 +128,10 @@ def run_episode(
         record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
+        on_frame = folder.frame_writer(world.class_names) if folder is not None else None
         planner.reset(EpisodeContext(
             instance=instance, goals=goals, llm=planner.llm,
-            on_frame=folder.frame_writer(world.class_names) if folder is not None else None,
+            on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
             trace_graphs=folder is not None and folder.graphs,
         ))
         clock.add("sense", t)
