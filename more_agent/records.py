@@ -103,6 +103,9 @@ class EpisodeRecord(BaseModel):
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
     start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
     description: str = Field(default="", description="Language description the planner received.")
+    descriptions: str = Field(
+        default="paper", description="How the description was written: 'named' (default since schema 'descriptions') or 'paper' (sim.descriptions)."
+    )
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
     all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
     done_called: bool = Field(default=False, description="Whether the planner ended the episode with done().")
@@ -136,7 +139,7 @@ class EpisodeRecord(BaseModel):
         """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
         return cls(
             task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, start=spec.start,
-            **fields,
+            descriptions=spec.descriptions, **fields,
         )
 
 
@@ -151,4 +154,7 @@ class EpisodeSpec(FrozenModel):
     start: str = Field(default="random", description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.")
     distractors: bool = Field(
         default=True, description="Add the scene's own small objects as distractor items (False: only the task's objects)."
+    )
+    descriptions: str = Field(
+        default="named", description="'named': the paper's text naming every goal instance the world makes ambiguous; 'paper': verbatim."
     )

@@ -45,6 +45,12 @@ DistractorsOption = Annotated[bool, typer.Option(
 )]
 """``--distractors/--no-distractors`` of ``run`` and ``eval``."""
 
+DescriptionsOption = Annotated[str, typer.Option(
+    help="Task descriptions: 'named' (the paper's text, naming every goal instance the world makes ambiguous and the "
+         "goal conditions it leaves out) or 'paper' (the paper's text verbatim)."
+)]
+"""``--descriptions`` of ``run`` and ``eval``."""
+
 
 class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""

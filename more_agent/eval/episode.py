@@ -113,7 +113,8 @@ def run_episode(
     scope: dict[str, str] = {}
     try:
         t = time.perf_counter()
-        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors)
+        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
+                               descriptions=spec.descriptions)
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
@@ -181,10 +182,11 @@ def ended_abnormally(record: EpisodeRecord) -> bool:
 
 def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
-    rebuilt from (task, scene, seed, start, distractors) in its initial state (objects where they started)."""
+    rebuilt from (task, scene, seed, start, distractors, descriptions) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
-    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors)
+    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
+                           descriptions=spec.descriptions)
     EpisodeFolder(out_dir).write_map(record, instance.world, set(instance.scope.values()))
 
 

@@ -38,13 +38,14 @@ class RunConfig(BaseModel):
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
     start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
     distractors: bool = Field(default=True, description="Whether every episode's world holds the scene's own small objects.")
+    descriptions: str = Field(default="paper", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions).")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
     more_agent_version: str = Field(default="", description="Package version that wrote the run.")
 
 
-MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "episode_fn")
+MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "descriptions", "episode_fn")
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 

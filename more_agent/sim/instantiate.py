@@ -28,7 +28,6 @@ Steps (all deterministic for a given task, scene and seed):
 
 from __future__ import annotations
 
-import re
 import time
 import zlib
 from dataclasses import dataclass, field
@@ -40,7 +39,9 @@ from bddl.condition_evaluation import compile_state
 from more_agent.errors import UserError
 from more_agent.sim import catalog
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
+from more_agent.sim.ambiguity import SCOPE_WORD
 from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
+from more_agent.sim.descriptions import check_description_mode, description_template
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
@@ -50,8 +51,8 @@ from more_agent.sim.tasks import (
     TaskDefinition,
     category_phrase,
     check_scene_suits,
-    describe_goal,
     draw_scenes,
+    literal_text,
     load_task,
     scope_synset,
 )
@@ -103,6 +104,10 @@ class TaskInstance:
     """World names of the scene's own small objects added as items (``sim.clutter``)."""
     start: StartFacts | None = None
     """Start room, task rooms and start-to-task path length at the start."""
+    descriptions: str = "named"
+    """How the description was written (``descriptions.DESCRIPTION_MODES``)."""
+    description_template: str = ""
+    """The description with ``$scope`` words where it names instances (``descriptions.description_template``)."""
 
     def scope_objects(self) -> dict[str, ScopeObject]:
         """The filled bddl scope: every entry a ``ScopeObject``."""
@@ -120,16 +125,19 @@ class TaskInstance:
 
 def instantiate(
     task: str, scene: str | None = None, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate ``task`` with ``seed`` in a scene generated with that seed.
 
     Without ``scene``, the scene is drawn with the seed among the task's suitable ones
     (``tasks.draw_scenes``; the next in the draw is tried when one cannot hold the task); a named
     scene must suit the task (scene .json files are taken as they are). ``start`` is one of
-    ``START_MODES``; ``distractors`` adds the scene's own small objects (``sim.clutter``).
+    ``START_MODES``; ``distractors`` adds the scene's own small objects (``sim.clutter``);
+    ``descriptions`` is one of ``DESCRIPTION_MODES``.
     """
     t0 = time.perf_counter()
     check_start(start)
+    check_description_mode(descriptions)
     definition = load_task(task)
     t_parse = time.perf_counter() - t0
     if scene is None:
@@ -147,7 +155,8 @@ def instantiate(
         scene_obj = get_scene(name, seed)
         t_scene = time.perf_counter() - t1
         try:
-            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors)
+            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors,
+                                            descriptions=descriptions)
         except InstantiationError as e:
             if scene is not None:
                 raise InstantiationError(f"{e} (scene {name}, seed {seed}); choose another --seed or --scene") from None
@@ -163,6 +172,7 @@ def instantiate(
 
 def instantiate_in_scene(
     definition: TaskDefinition | str, scene: Scene, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate a task in a given ``Scene`` object (hand-built scenes included)."""
     if isinstance(definition, str):
@@ -188,7 +198,7 @@ def instantiate_in_scene(
         task=definition.name, scene=scene.name, seed=seed, world=world, description="",
         scope=builder.scope, virtual_scopes=sorted(builder.virtual), unsupported_literals=builder.unsupported,
         timings={}, definition=definition, start_mode=start, distractors=clutter.items,
-        start=start_facts(world, targets),
+        start=start_facts(world, targets), descriptions=descriptions,
     )
     _verify_init(instance)
     instance.description = task_description(instance)
@@ -197,15 +207,14 @@ def instantiate_in_scene(
 
 
 def task_description(instance: TaskInstance) -> str:
-    """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal.
+    """The description of ``descriptions.description_template`` with ``$scope`` words replaced by labels.
 
     The instances it names get their labels here, before the episode, so that the description and
     the scene text agree; every other instance is labelled when first observed.
     """
-    text = instance.definition.paper_description
-    if text is not None:
-        return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: _scope_phrase(instance, m.group(1)), text)
-    return describe_goal(instance.definition.goal, lambda s: _readable(instance.world, instance.scope[s], reserve=True))
+    instance.description_template = description_template(
+        instance.definition, instance.world, instance.scope, instance.descriptions)
+    return SCOPE_WORD.sub(lambda m: _scope_phrase(instance, m.group(1)), instance.description_template)
 
 
 def _scope_phrase(instance: TaskInstance, scope: str) -> str:
@@ -213,11 +222,6 @@ def _scope_phrase(instance: TaskInstance, scope: str) -> str:
     if scope in instance.scope:
         return _readable(instance.world, instance.scope[scope], reserve=True)
     return f"the {category_phrase(scope_synset(scope))}"
-
-
-def literal_text(literal: ParsedLiteral) -> str:
-    """A parsed bddl literal in BDDL form: ['not', ['open', 'x']] -> '(not (open x))'."""
-    return "(" + " ".join(literal_text(x) if isinstance(x, list) else x for x in literal) + ")"
 
 
 class _Builder:
