@@ -58,6 +58,13 @@ class Camera:
         """Focal length in pixels (square pixels: fx = fy)."""
         return (self.width / 2) / math.tan(math.radians(self.hfov_deg) / 2)
 
+    @property
+    def blind_floor_m(self) -> float:
+        """Distance from the camera's foot within which the floor lies below the image's bottom edge:
+        the robot never sees the floor this close to it (0.95 m with the default geometry)."""
+        half_vfov = math.atan((self.height / 2) / self.focal_px)
+        return self.height_m / math.tan(math.radians(self.pitch_deg) + half_vfov)
+
     def intrinsics(self) -> np.ndarray:
         """The 3x3 intrinsic matrix K (float64)."""
         f = self.focal_px

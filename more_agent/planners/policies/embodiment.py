@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
+from more_agent.sim.camera import Camera
 from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
 from more_agent.sim.motion import full_turn_angles
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
@@ -45,9 +46,9 @@ class PolicyConfig(BaseModel):
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
     blind_radius_m: float = Field(
-        default=0.55, ge=0, description="Unknown cells this close to where the robot has been count as free on "
-        "its map: the camera (1.2 m high, pitched 20 degrees, 90 degree field of view) never sees the floor within "
-        "0.56 m of the robot."
+        default_factory=lambda: Camera().blind_floor_m, ge=0,
+        description="Unknown cells this close to where the robot has been count as free on its map: the camera "
+        "never sees the floor this close to the robot (``Camera.blind_floor_m``, 0.95 m for the Fetch's head camera).",
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
