@@ -7,7 +7,14 @@ from typing import Annotated
 
 import typer
 
-from more_agent.commands._common import EXIT_RETRYABLE, DistractorsOption, StartOption, err_console, user_errors_exit_2
+from more_agent.commands._common import (
+    EXIT_RETRYABLE,
+    DistractorsOption,
+    HistoryOption,
+    StartOption,
+    err_console,
+    user_errors_exit_2,
+)
 from more_agent.errors import UserError
 
 
@@ -23,6 +30,7 @@ def eval_(
     )] = None,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
+    history: HistoryOption = "paper",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -54,6 +62,7 @@ def eval_(
     from more_agent.eval.report_writer import write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
+    from more_agent.llm.prompts import check_history
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits
 
@@ -66,6 +75,7 @@ def eval_(
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
     check_start(start)
+    history_mode = check_history(history)
     if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
         from more_agent.sim.scenes import get_scene
@@ -84,6 +94,7 @@ def eval_(
         scene=scene,
         start=start,
         distractors=distractors,
+        history=history_mode,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

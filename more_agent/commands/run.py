@@ -18,6 +18,7 @@ from more_agent.commands._common import (
     EXIT_FAILED,
     EXIT_RETRYABLE,
     DistractorsOption,
+    HistoryOption,
     StartOption,
     console,
     user_errors_exit_2,
@@ -81,6 +82,7 @@ def run(
     seed: Annotated[int, typer.Option(min=0, help="Seed of the scene draw, scene generation, instantiation and start pose.")] = 0,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
+    history: HistoryOption = "paper",
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
@@ -94,12 +96,14 @@ def run(
     """
     from more_agent.eval.episode import ended_abnormally, run_episode
     from more_agent.eval.viewer import run_episode_with_viewer
+    from more_agent.llm.prompts import check_history
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task
 
     load_task(task)  # an unknown task fails first, with the closest names
     check_start(start)
+    history_mode = check_history(history)
     if scene is not None:
         check_scene_suits(task, scene)
     if planner is None:
@@ -109,7 +113,8 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors)
+    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
+                       history=history_mode)
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
