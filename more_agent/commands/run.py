@@ -113,8 +113,10 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
-                       history=history_mode)
+    spec = EpisodeSpec(
+        task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
+        history=history_mode,
+    )
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,

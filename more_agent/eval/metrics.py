@@ -82,7 +82,7 @@ class Estimate(FrozenModel):
     mean: float = Field(description="Mean over episodes, in [0, 1].")
     low: float = Field(description="Lower end of the 95% interval.")
     high: float = Field(description="Upper end of the 95% interval.")
-    n: int = Field(description="Number of episodes with a value (every episode has an SR, TTC and TP; not every one an rTP).")
+    n: int = Field(description="Episodes with a value (each has an SR, TTC and TP; not each an rTP).")
     method: Literal["wilson", "bootstrap"] = Field(description="How the interval was computed.")
 
 
@@ -95,7 +95,7 @@ class MetricSummary(FrozenModel):
     SR: Estimate
     TTC: Estimate
     TP: Estimate
-    rTP: Estimate | None = Field(description="None when no episode of the group has an rTP (none observed a goal condition).")
+    rTP: Estimate | None = Field(description="None when no episode of the group has an rTP (none saw a goal condition).")
 
 
 def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:

@@ -1,11 +1,11 @@
 """``SceneGraphBuilder``: fuses frames incrementally and builds a ``SceneGraph`` per high-level step.
 
 ``integrate`` (every frame) only updates the voxel map and per-instance bookkeeping (attributes,
-viewpoints, what rides on the held object). ``build`` (once per step) runs the graph pipeline ``mapping.region_graph`` on the BEV
-(Voronoi graph -> sparsification -> door cuts -> regions (+ sub-region merging) -> Eq. 1 object
-assignment -> frontiers), then gives regions stable ids, reduces everything to the robot's
-navigable component and adds the spatial relations (as perceived where the instance information
-says how an object rests, from box geometry otherwise).
+viewpoints, what rides on the held object). ``build`` (once per step) runs the graph pipeline
+``mapping.region_graph`` on the BEV (Voronoi graph -> sparsification -> door cuts -> regions
+(+ sub-region merging) -> Eq. 1 object assignment -> frontiers), then gives regions stable ids,
+reduces everything to the robot's navigable component and adds the spatial relations (as perceived
+where the instance information says how an object rests, from box geometry otherwise).
 
 Region ids: each region keeps an anchor point; at the next build a region inherits the id of the
 old anchor(s) whose nearest node (within ``2 * sparsify_threshold_m``) it contains, the smallest

@@ -93,8 +93,9 @@ class Embodiment:
 
         The robot knows what it did: an item released since the last frame is reported as no longer
         held, resting where it was put, even when no camera sees it (the builder keeps it, and what
-        rode on or in it, at their boxes until a frame shows them), and the objects in ``acted_on`` (world names: what it just opened or
-        closed) are reported with their new state even when out of view.
+        rode on or in it, at their boxes until a frame shows them), and the objects in ``acted_on``
+        (world names: what it just opened or closed) are reported with their new state even when out
+        of view.
         """
         frame = self.renderer.render(self.world)
         if self.on_frame is not None:
