@@ -126,7 +126,8 @@ class SceneGraphBuilder:
         an obstacle where the robot stands) and are kept in the graph, travelling with the robot."""
         by_label = {info.label: iid for iid, info in self._instances.items()}
         carried = set()
-        for iid, info in self._instances.items():
+        holding = any(info.held for info in self._instances.values())
+        for iid, info in self._instances.items() if holding else ():
             chain = info
             for _ in range(len(by_label)):  # up the supports, as far as the held object (cycles end it)
                 support = by_label.get(chain.rests[1]) if chain.rests is not None and chain.rests[1] else None
