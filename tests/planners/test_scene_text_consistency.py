@@ -21,15 +21,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from more_agent.eval.episode import run_episode
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.prompts import HISTORY_LAST_N, LASTING_SKILLS
-from more_agent.planners.base import HighLevelAction
+from more_agent.planners.base import EpisodeContext, HighLevelAction
 from more_agent.planners.language import FLOOR, HELD, SceneView, room_names
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
-from more_agent.records import EpisodeSpec
+from more_agent.records import ActionRecord, EpisodeSpec, HistoryMode
 from more_agent.scene_graph import SceneGraph
+from more_agent.sim.goals import GoalChecker
+from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.scene import load_scene
 from tests.planners.brain import plan
 
 TINY = Path(__file__).parents[1] / "fixtures" / "tiny_scene.json"
@@ -266,3 +270,37 @@ def test_scene_text_agrees_with_graph_and_history_every_step() -> None:
     # The random episodes did exercise what the text must show, also after the history forgot the deed.
     assert done["grasped"] >= 6 and done["placed"] >= 4 and done["opened"] + done["closed"] >= 4, done
     assert old_deeds >= 10
+
+
+class RecordingBrain(RandomBrain):
+    """A RandomBrain that keeps the plan prompts it was asked."""
+
+    def __init__(self, seed: int) -> None:
+        super().__init__(seed)
+        self.plan_prompts: list[str] = []
+
+    def __call__(self, body: dict[str, Any]) -> str:
+        user = body["messages"][-1]["content"]
+        if "Previous actions:" in user:
+            self.plan_prompts.append(user)
+        return super().__call__(body)
+
+
+@pytest.mark.parametrize("history", ["paper", "lasting"])
+def test_the_history_option_reaches_the_plan_prompt(history: HistoryMode) -> None:
+    """An old successful grasp is in the prompt's history only with ``lasting``; a failed one always."""
+    brain = RecordingBrain(0)
+    client = ScriptedClient(brain)
+    agent = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, "scripted"))
+    instance = instantiate_in_scene(TASK, load_scene(TINY), seed=0)
+    agent.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance), history=history))
+    old = [
+        ActionRecord(step=0, name="go_to_and_grasp", arguments=["kitchen_0", "apple A"], ok=True, feedback="grasped apple A"),
+        ActionRecord(step=1, name="explore", arguments=["kitchen_0"], ok=False, feedback="no unexplored area"),
+    ]
+    agent.history = old + [ActionRecord(step=k, name="explore", arguments=["kitchen_0"], ok=True) for k in range(2, 8)]
+    agent.observe()
+    agent.decide()
+    shown = brain.plan_prompts[-1].split("Previous actions:\n", 1)[1]
+    assert ("1. go_to_and_grasp(kitchen_0, apple A) -> succeeded: grasped apple A" in shown) == (history == "lasting")
+    assert "2. explore(kitchen_0) -> failed: no unexplored area" in shown and "8. explore(kitchen_0)" in shown
