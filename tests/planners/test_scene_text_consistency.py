@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 import re
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -109,15 +109,15 @@ class Deeds:
     """What the successful actions so far did, from their feedback (labels, as the world names them)."""
 
     held: str | None = None
-    placed: dict[str, tuple[str, str]] | None = None
+    placed: dict[str, tuple[str, str]] = field(default_factory=dict)
     """Item -> ('inside' | 'on top of', label of the container / support, or 'the floor of <room>')."""
-    state: dict[str, str] | None = None
+    state: dict[str, str] = field(default_factory=dict)
     """Openable -> 'open' | 'closed'."""
 
 
 def deeds(history: list[Any]) -> Deeds:
     """Replay the feedback of the successful actions ('grasped apple A', 'placed apple A inside fridge A')."""
-    d = Deeds(placed={}, state={})
+    d = Deeds()
     for a in history:
         if not a.ok:
             continue
@@ -157,7 +157,7 @@ def check_deeds(view: SceneView, graph: SceneGraph, history: list[Any], planner:
         assert view.held == name[did.held] and held and all(e[0] == name[did.held] for e in held), (
             f"{did.held} was grasped: the text must show it held\n{view.text()}")
         assert any(e[3] for e in rooms[view.robot_room][1]), "the held item is listed in the robot's room"
-    for item, (how, where) in (did.placed or {}).items():
+    for item, (how, where) in did.placed.items():
         if not present(item, f"placed {how} {where}"):
             continue
         shown = [e for e in entries if e[0] == name[item] and not e[3]]
@@ -166,7 +166,7 @@ def check_deeds(view: SceneView, graph: SceneGraph, history: list[Any], planner:
         if options.spatial_relations and (on_floor or present(where, f"{item} placed {how} it")):
             want = None if on_floor else (how, name[where])
             assert any(e[2] == want for e in shown), f"{item} placed {how} {where}, the text shows {shown}"
-    for obj, state in (did.state or {}).items():
+    for obj, state in did.state.items():
         if present(obj, state):
             assert any(e[0] == name[obj] and e[1] == state for e in entries), f"{obj} was left {state}\n{view.text()}"
     regions_seen.update(graph.regions)
