@@ -52,7 +52,8 @@ def row(task_set_name: str, planner: str, records: list[EpisodeRecord], s: Metri
     return {
         "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
         "descriptions": sorted({r.descriptions for r in records}),
-        "sr": _pct(s.SR.mean), "ttc": _pct(s.TTC.mean), "tp": _pct(s.TP.mean), "rtp": _pct(s.rTP.mean),
+        "sr": _pct(s.SR.mean), "ttc": _pct(s.TTC.mean), "tp": _pct(s.TP.mean),
+        "rtp": _pct(s.rTP.mean) if s.rTP is not None else None,
         "n_unambiguous": clear.n, "sr_unambiguous": round(100 * clear.SR.mean, 1) if clear.n else None,
         "successes_per_seed": {seed: sum(r.success for r in records if r.seed == seed)
                                for seed in sorted({r.seed for r in records})},

@@ -51,6 +51,12 @@ DescriptionsOption = Annotated[str, typer.Option(
 )]
 """``--descriptions`` of ``run`` and ``eval``."""
 
+HistoryOption = Annotated[str, typer.Option(
+    help="Action history of the LLM and VLM planners: 'paper' (the last five actions and every failed one) or "
+    "'lasting' (our extension: also every earlier successful grasp, place, open and close)."
+)]
+"""``--history`` of ``run`` and ``eval``."""
+
 
 class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""

@@ -11,6 +11,7 @@ from more_agent.commands._common import (
     EXIT_RETRYABLE,
     DescriptionsOption,
     DistractorsOption,
+    HistoryOption,
     StartOption,
     err_console,
     user_errors_exit_2,
@@ -31,6 +32,7 @@ def eval_(
     start: StartOption = "random",
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
+    history: HistoryOption = "paper",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -63,6 +65,7 @@ def eval_(
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
     from more_agent.sim.descriptions import check_description_mode
+    from more_agent.llm.prompts import check_history
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits
 
@@ -76,6 +79,7 @@ def eval_(
     names = resolve_tasks(tasks)
     check_start(start)
     check_description_mode(descriptions)
+    history_mode = check_history(history)
     if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
         from more_agent.sim.scenes import get_scene
@@ -95,6 +99,7 @@ def eval_(
         start=start,
         distractors=distractors,
         descriptions=descriptions,
+        history=history_mode,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

@@ -19,6 +19,7 @@ from more_agent.commands._common import (
     EXIT_RETRYABLE,
     DescriptionsOption,
     DistractorsOption,
+    HistoryOption,
     StartOption,
     console,
     user_errors_exit_2,
@@ -83,6 +84,7 @@ def run(
     start: StartOption = "random",
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
+    history: HistoryOption = "paper",
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
@@ -96,6 +98,7 @@ def run(
     """
     from more_agent.eval.episode import ended_abnormally, run_episode
     from more_agent.eval.viewer import run_episode_with_viewer
+    from more_agent.llm.prompts import check_history
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
@@ -104,6 +107,7 @@ def run(
     load_task(task)  # an unknown task fails first, with the closest names
     check_start(start)
     check_description_mode(descriptions)
+    history_mode = check_history(history)
     if scene is not None:
         check_scene_suits(task, scene)
     if planner is None:
@@ -113,8 +117,10 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
-                       descriptions=descriptions)
+    spec = EpisodeSpec(
+        task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
+        descriptions=descriptions, history=history_mode,
+    )
     with console.status(f"running {task} with planner {planner} ..."):
         record = (run_episode_with_viewer if viewer else run_episode)(
             spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,

@@ -124,7 +124,7 @@ def run_episode(
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=planner.llm,
+            instance=instance, goals=goals, llm=planner.llm, history=spec.history,
             on_frame=folder.frame_writer(world.class_names) if folder is not None else None,
             trace_graphs=folder is not None and folder.graphs,
         ))

@@ -19,7 +19,14 @@ from pydantic import BaseModel, Field, ValidationError
 
 from more_agent.errors import UserError, check_writable_dir
 from more_agent.eval.runlock import LOCK_FILE
-from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.records import (
+    DEFAULT_HISTORY,
+    LEGACY_DESCRIPTIONS,
+    EpisodeRecord,
+    EpisodeSpec,
+    HistoryMode,
+    legacy_history,
+)
 
 EPISODES_FILE = "episodes.jsonl"
 RETRIED_FILE = "retried.jsonl"
@@ -38,14 +45,19 @@ class RunConfig(BaseModel):
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
     start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
     distractors: bool = Field(default=True, description="Whether every episode's world holds the scene's own small objects.")
-    descriptions: str = Field(default="paper", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions).")
+    descriptions: str = Field(
+        default="named", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions)."
+    )
+    history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
     more_agent_version: str = Field(default="", description="Package version that wrote the run.")
 
 
-MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "descriptions", "episode_fn")
+MIXING_FIELDS = (
+    "planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "descriptions", "history", "episode_fn",
+)
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 
@@ -60,8 +72,12 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     planners = sorted({r.planner for r in records})
     llms = sorted({str(r.llm) for r in records})
     starts = sorted({r.start for r in records})
+    histories = sorted({r.history for r in records})
+    descriptions = sorted({r.descriptions for r in records})
     return config.model_copy(update={
         "start": starts[0] if len(starts) == 1 else ",".join(starts),
+        "history": histories[0] if len(histories) == 1 else ",".join(histories),
+        "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
         "planner": planners[0] if len(planners) == 1 else ",".join(planners),
         "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
         "tasks": sorted({r.task for r in records} | set(config.tasks)),
@@ -226,12 +242,18 @@ def write_run_config(run_dir: Path, config: RunConfig) -> None:
 
 
 def read_run_config(run_dir: Path) -> RunConfig | None:
-    """The run's configuration, or None if ``run.json`` is missing."""
+    """The run's configuration, or None if ``run.json`` is missing. A ``run.json`` written before the
+    history option gets the history its episodes ran with (:func:`~more_agent.records.legacy_history`)."""
     path = Path(run_dir) / RUN_FILE
     if not path.exists():
         return None
     try:
-        return RunConfig.model_validate(json.loads(path.read_text(encoding="utf-8")))
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if isinstance(data, dict) and "history" not in data:
+            data = legacy_history(data)
+        if isinstance(data, dict) and "descriptions" not in data:
+            data = {**data, "descriptions": LEGACY_DESCRIPTIONS}
+        return RunConfig.model_validate(data)
     except (ValueError, ValidationError) as e:
         raise UserError(f"{path} is not a valid run configuration: {e}") from None
 
@@ -250,8 +272,8 @@ def prepare_run_dir(
     """Create or reopen a run directory and return the records already in it.
 
     Without ``resume`` a non-empty directory is refused. With ``resume`` the planner, LLM, tasks,
-    seeds, scene, start mode and episode function must match the stored ``run.json`` (or, when it is missing,
-    the records), unless ``allow_mixed``; a torn last line is truncated.
+    seeds, scene, start mode, distractors, history and episode function must match the stored
+    ``run.json`` (or, when it is missing, the records), unless ``allow_mixed``; a torn last line is truncated.
     """
     run_dir = Path(run_dir)
     check_run_dir(run_dir)

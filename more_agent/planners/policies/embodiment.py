@@ -93,9 +93,10 @@ class Embodiment:
         """Render a frame from the current pose and fuse it into the scene-graph builder.
 
         The robot knows what it did: an item released since the last frame is reported as no longer
-        held, resting where it was put, even when no camera sees it (the builder keeps it at that box
-        until a frame shows it), and the objects in ``acted_on`` (world names: what it just opened or
-        closed) are reported with their new state even when out of view.
+        held, resting where it was put, even when no camera sees it (the builder keeps it, and what
+        rode on or in it, at their boxes until a frame shows them), and the objects in ``acted_on``
+        (world names: what it just opened or closed) are reported with their new state even when out
+        of view.
         """
         frame = self.renderer.render(self.world)
         if self.on_frame is not None:
@@ -114,7 +115,8 @@ class Embodiment:
                 held=self.world.robot.held == name, rests=self._rests(name),
             ))
         if released is not None:
-            self.builder.remember(self.world.get(released).instance_id, *self.world.get(released).box())
+            for obj in [self.world.get(released), *self.world.descendants(released)]:  # with what rode on it
+                self.builder.remember(obj.instance_id, *obj.box())
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
