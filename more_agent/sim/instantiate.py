@@ -3,7 +3,9 @@
 Steps (all deterministic for a given task, scene and seed):
 1. Scopes bound by ``inroom`` literals take existing scene objects: per room type, the first room
    of that type (scene order) where every such scope gets its own piece of furniture of a matching
-   category (bipartite matching); ``floor.n.01_k`` takes that room's floor.
+   category (bipartite matching); ``floor.n.01_k`` takes that room's floor. Wall fixtures the plan
+   leaves out (wall nails, hooks, mirrors, ...) are hung first where bddl lists them and a scope
+   needs their category (``sim.fixtures``).
 2. ``agent.n.01_1`` stands for the robot; substances and ``future`` objects are virtual scopes.
 3. Every other scope becomes a new item: category from the synset (the synset's own category when
    it has one, else one drawn with the seed), size from the catalogue, name from the scope
@@ -38,10 +40,11 @@ from bddl.condition_evaluation import compile_state
 
 from more_agent.errors import UserError
 from more_agent.sim import catalog
-from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.ambiguity import SCOPE_WORD
+from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
 from more_agent.sim.descriptions import check_description_mode, description_template
+from more_agent.sim.fixtures import hang_listed_fixtures
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
@@ -259,6 +262,9 @@ class _Builder:
                 )
             ground = [s for s in scopes if _ground_class(scope_synset(s))]
             fixed = [s for s in scopes if s not in ground]
+            needed = {c for s in fixed for c in catalog.synset_categories(scope_synset(s))}
+            for room in rooms:
+                hang_listed_fixtures(self.world, room.id, needed)
             best_room, best = rooms[0].id, self._match_room(rooms[0].id, fixed)
             for room in rooms[1:]:
                 if len(best) == len(fixed):
@@ -381,8 +387,16 @@ class _Builder:
     def _on_support(self, name: str, support: str, relation: str, atom: ParsedLiteral) -> None:
         """Rest ``name`` at a free slot of ``support``, on the items already there when it is full;
         unlike a magic place action, never where another box already is (a full closed container
-        fails this scene)."""
-        if not self.world.place_if_room(name, support, relation, stack=True):
+        fails this scene). An item with no slot as it comes is turned a quarter and tried again when
+        its turned footprint lies within the surface (the slot grid follows the item's footprint:
+        a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
+        if self.world.place_if_room(name, support, relation, stack=True):
+            return
+        obj = self.world.objects[name]
+        lo, hi, _ = self.world.support_surface(self.world.objects[support], relation)
+        obj.size = obj.size[[1, 0, 2]]
+        if not (np.all(obj.size[:2] <= hi - lo) and self.world.place_if_room(name, support, relation, stack=True)):
+            obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 
     def _default_floor(self) -> str:
