@@ -158,3 +158,14 @@ def test_the_graph_shows_the_hand_empty_right_after_a_floor_placement() -> None:
     assert result.ok, result.feedback
     after = body.build()  # no move since: only the frame the placement took can tell
     assert after.held_object is None and item.id in after.objects
+
+
+def test_the_robot_can_drive_back_along_a_magic_actions_approach() -> None:
+    # A go-to-and-act approach adds only its waypoints to the trajectory, metres apart, through space
+    # the map never saw: the robot stood on every cell between them, so it can drive back that way.
+    grid = np.full((30, 30), 0)  # all unknown
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    jump = [(0.35, 0.35), (2.55, 0.35), (2.55, 2.55)]
+    nav = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=jump, retrace=True)
+    path, index = path_to_nearest(nav, jump[-1], [jump[0]], snap_m=0.2)
+    assert index == 0 and path.found and path.length_m == pytest.approx(4.4, abs=0.2)
