@@ -13,7 +13,9 @@ empty: no reader can beat chance on the others, docs/tasks.md); then one line pe
 the SR and TP gaps, overall and on those episodes. It reads the worlds only through the harness, so it
 runs unchanged on other worlds. Run:
 ``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--workers 2] [--limit N]
-[--start random|random-area|task-room] [--no-distractors]`` (run folders ``<out>/<start>[-no-distractors]/<task set>/<planner>``).
+[--start random|random-area|task-room] [--no-distractors] [--descriptions named paper]`` (run folders
+``<out>/<start>[-no-distractors]/descriptions-<mode>/<task set>/<planner>``; the oracle reads no description
+and runs in the first mode only). Each line also gives TTC and rTP, and the description modes of its records.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from more_agent.eval.report import SourcedRecord
 from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import RunConfig
 from more_agent.records import EpisodeRecord
+from more_agent.sim.descriptions import DESCRIPTION_MODES
 from more_agent.sim.tasks import task_set
 
 PLANNERS = ("grounded", "oracle")
@@ -48,7 +51,9 @@ def row(task_set_name: str, planner: str, records: list[EpisodeRecord], s: Metri
     plan_ms = [1000 * r.timings.get("plan", 0.0) / r.high_level_steps for r in records if r.high_level_steps]
     return {
         "task_set": task_set_name, "planner": planner, "n": s.n, "errors": s.n_errors,
-        "sr": round(100 * s.SR.mean, 1), "tp": round(100 * s.TP.mean, 1),
+        "descriptions": sorted({r.descriptions for r in records}),
+        "sr": _pct(s.SR.mean), "ttc": _pct(s.TTC.mean), "tp": _pct(s.TP.mean),
+        "rtp": _pct(s.rTP.mean) if s.rTP is not None else None,
         "n_unambiguous": clear.n, "sr_unambiguous": round(100 * clear.SR.mean, 1) if clear.n else None,
         "successes_per_seed": {seed: sum(r.success for r in records if r.seed == seed)
                                for seed in sorted({r.seed for r in records})},
@@ -57,6 +62,10 @@ def row(task_set_name: str, planner: str, records: list[EpisodeRecord], s: Metri
         "reach_failures_per_100_steps": round(100 * reach / steps, 2) if steps else None,
         "median_plan_ms_per_step": round(statistics.median(plan_ms), 3) if plan_ms else None,
     }
+
+
+def _pct(x: float | None) -> float | None:
+    return None if x is None else round(100 * x, 1)
 
 
 def main() -> None:
@@ -72,28 +81,34 @@ def main() -> None:
     parser.add_argument("--distractors", action=argparse.BooleanOptionalAction, default=True,
                         help="add the scenes' own small objects (--no-distractors with --start task-room: the worlds "
                              "before the harder-worlds issue, scene still drawn per seed)")
+    parser.add_argument("--descriptions", nargs="+", default=list(DESCRIPTION_MODES), choices=DESCRIPTION_MODES,
+                        help="description modes (sim.descriptions); the oracle reads none, so it runs once")
     args = parser.parse_args()
 
+    worlds = args.start if args.distractors else f"{args.start}-no-distractors"
     for name in args.task_sets:
         tasks = task_set(name)[: args.limit]
-        results: dict[str, tuple[MetricSummary, MetricSummary]] = {}
-        for planner in args.planners:
-            config = RunConfig(
-                planner=planner, tasks=tasks, seeds=list(range(args.seeds)), episode_fn="more_agent.eval.episode:run_episode",
-                workers=args.workers, start=args.start, distractors=args.distractors, more_agent_version=__version__,
-            )
-            run_dir = args.out / (args.start if args.distractors else f"{args.start}-no-distractors") / name / planner
-            records = evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
-            write_reports([SourcedRecord(r, run_dir) for r in records], run_dir, title=f"{planner} on {name}")
-            results[planner] = summarize(records), summarize(unambiguous(records))
-            print(json.dumps(row(name, planner, records, *results[planner])), flush=True)
-        if set(PLANNERS) <= set(results):
-            (g, gc), (o, oc) = results["grounded"], results["oracle"]
-            print(json.dumps({
-                "task_set": name, "sr_gap": round(100 * (o.SR.mean - g.SR.mean), 1),
-                "tp_gap": round(100 * (o.TP.mean - g.TP.mean), 1),
-                "sr_gap_unambiguous": round(100 * (oc.SR.mean - gc.SR.mean), 1),
-            }), flush=True)
+        for mode in args.descriptions:
+            results: dict[str, tuple[MetricSummary, MetricSummary]] = {}
+            for planner in args.planners:
+                reads_description = planner != "oracle"
+                run_mode = mode if reads_description else args.descriptions[0]
+                config = RunConfig(
+                    planner=planner, tasks=tasks, seeds=list(range(args.seeds)),
+                    episode_fn="more_agent.eval.episode:run_episode", workers=args.workers, start=args.start,
+                    distractors=args.distractors, descriptions=run_mode, more_agent_version=__version__,
+                )
+                run_dir = args.out / worlds / f"descriptions-{run_mode}" / name / planner
+                records = evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
+                write_reports([SourcedRecord(r, run_dir) for r in records], run_dir, title=f"{planner} on {name}")
+                results[planner] = summarize(records), summarize(unambiguous(records))
+                print(json.dumps(row(name, planner, records, *results[planner])), flush=True)
+            if set(PLANNERS) <= set(results):
+                (g, gc), (o, oc) = results["grounded"], results["oracle"]
+                print(json.dumps({
+                    "task_set": name, "descriptions": mode, "sr_gap": _pct(o.SR.mean - g.SR.mean),
+                    "tp_gap": _pct(o.TP.mean - g.TP.mean), "sr_gap_unambiguous": _pct(oc.SR.mean - gc.SR.mean),
+                }), flush=True)
 
 
 if __name__ == "__main__":

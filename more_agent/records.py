@@ -6,11 +6,13 @@ Written as ``DIR/episode.json`` by ``more-agent run`` and as one line of ``DIR/e
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-RECORD_SCHEMA_VERSION = 2
+RECORD_SCHEMA_VERSION = 3
+"""3: ``history`` (the action history option) and ``descriptions`` (the description mode); records of
+version 2 read as :data:`LEGACY_HISTORY` for LLM planners and :data:`LEGACY_DESCRIPTIONS`."""
 
 FailureCause = Literal[
     "never_observed",
@@ -25,6 +27,34 @@ FailureCause = Literal[
     "other",
 ]
 """Why an unsuccessful episode failed; the classes are documented in docs/evaluation.md."""
+
+HistoryMode = Literal["paper", "lasting"]
+"""The action history the LLM and VLM planners show: ``paper``, the last five actions and every earlier
+failed one (paper Sec. III-C); ``lasting``, our extension, also every earlier successful grasp, place,
+open and close (``more_agent.llm.prompts.history_text``)."""
+
+HISTORY_MODES: tuple[HistoryMode, ...] = ("paper", "lasting")
+DEFAULT_HISTORY: HistoryMode = "paper"
+
+LEGACY_HISTORY: HistoryMode = "lasting"
+"""What an LLM planner was shown by the versions before the history option (since the skill table)."""
+
+
+LEGACY_DESCRIPTIONS = "paper"
+"""The description mode of the versions before the option: the paper's text (the instances its ``$``
+words name, nothing more)."""
+
+
+def upgrade_from_2(data: dict[str, Any]) -> dict[str, Any]:
+    """A record of schema 2 in schema 3's form: the history and descriptions its episode ran with."""
+    data = legacy_history(data) if "history" not in data else data
+    return {"descriptions": LEGACY_DESCRIPTIONS, **data, "schema_version": 3}
+
+
+def legacy_history(data: dict[str, Any]) -> dict[str, Any]:
+    """Stored ``data`` (a record or run configuration) written before the history option, with the
+    ``history`` its episodes ran with: the longer one for an LLM planner, else the default."""
+    return {**data, "history": LEGACY_HISTORY if data.get("llm") else DEFAULT_HISTORY}
 
 
 class FrozenModel(BaseModel):
@@ -106,6 +136,12 @@ class EpisodeRecord(BaseModel):
         default=None, description="Whether the world held the scene's own small objects; None in records written before it was kept."
     )
     description: str = Field(default="", description="Language description the planner received.")
+    descriptions: str = Field(
+        default="named", description="How the description was written: 'named' or 'paper' (sim.descriptions)."
+    )
+    history: HistoryMode = Field(
+        default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners (others ignore it)."
+    )
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
     all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
     done_called: bool = Field(default=False, description="Whether the planner ended the episode with done().")
@@ -130,6 +166,14 @@ class EpisodeRecord(BaseModel):
     )
     traceback: str | None = Field(default=None, description="Python traceback when the episode raised.")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _before_history_option(cls, data: Any) -> Any:
+        """A stored record of schema version 2 says which history and descriptions its episode ran with."""
+        if isinstance(data, dict) and data.get("schema_version", RECORD_SCHEMA_VERSION) == 2:
+            return upgrade_from_2(data)
+        return data
+
     def key(self) -> tuple[str, str, int, str]:
         """Identity of the episode within a run: (task, scene, seed, planner)."""
         return (self.task, self.scene, self.seed, self.planner)
@@ -139,7 +183,7 @@ class EpisodeRecord(BaseModel):
         """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
         return cls(
             task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, start=spec.start,
-            distractors=spec.distractors, **fields,
+            distractors=spec.distractors, descriptions=spec.descriptions, history=spec.history, **fields,
         )
 
 
@@ -155,3 +199,7 @@ class EpisodeSpec(FrozenModel):
     distractors: bool = Field(
         default=True, description="Add the scene's own small objects as distractor items (False: only the task's objects)."
     )
+    descriptions: str = Field(
+        default="named", description="'named': the paper's text naming every goal instance the world makes ambiguous; 'paper': verbatim."
+    )
+    history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")

@@ -64,6 +64,18 @@ DistractorsOption = Annotated[bool, typer.Option(
 )]
 """``--distractors/--no-distractors`` of ``run`` and ``eval``."""
 
+DescriptionsOption = Annotated[str, typer.Option(
+    help="Task descriptions: 'named' (the paper's text, naming every goal instance the world makes ambiguous and the "
+         "goal conditions it leaves out) or 'paper' (the paper's text verbatim)."
+)]
+"""``--descriptions`` of ``run`` and ``eval``."""
+
+HistoryOption = Annotated[str, typer.Option(
+    help="Action history of the LLM and VLM planners: 'paper' (the last five actions and every failed one) or "
+    "'lasting' (our extension: also every earlier successful grasp, place, open and close)."
+)]
+"""``--history`` of ``run`` and ``eval``."""
+
 
 class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""

@@ -12,7 +12,9 @@ from more_agent.commands._common import (
     EXIT_FAILED,
     EXIT_RETRYABLE,
     MAX_SEEDS,
+    DescriptionsOption,
     DistractorsOption,
+    HistoryOption,
     StartOption,
     err_console,
     episodes_exit_status,
@@ -36,6 +38,8 @@ def eval_(
     )] = None,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
+    descriptions: DescriptionsOption = "named",
+    history: HistoryOption = "paper",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -69,6 +73,8 @@ def eval_(
     from more_agent.eval.report_writer import write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
+    from more_agent.sim.descriptions import check_description_mode
+    from more_agent.llm.prompts import check_history
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits
 
@@ -83,6 +89,8 @@ def eval_(
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
     check_start(start)
+    check_description_mode(descriptions)
+    history_mode = check_history(history)
     if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
         from more_agent.sim.scenes import get_scene
@@ -101,6 +109,8 @@ def eval_(
         scene=scene,
         start=start,
         distractors=distractors,
+        descriptions=descriptions,
+        history=history_mode,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

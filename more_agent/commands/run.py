@@ -20,7 +20,9 @@ from rich.text import Text
 
 from more_agent.commands._common import (
     MAX_SEED,
+    DescriptionsOption,
     DistractorsOption,
+    HistoryOption,
     StartOption,
     console,
     episodes_exit_status,
@@ -103,6 +105,8 @@ def run(
     )] = 0,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
+    descriptions: DescriptionsOption = "named",
+    history: HistoryOption = "paper",
     out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
     save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
@@ -122,12 +126,16 @@ def run(
     from more_agent.eval.episode_folder import check_folder_for
     from more_agent.eval.runlock import locked_run_dir
     from more_agent.eval.viewer import run_episode_with_viewer
+    from more_agent.llm.prompts import check_history
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
+    from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task
 
     load_task(task)  # an unknown task fails first, with the closest names
     check_start(start)
+    check_description_mode(descriptions)
+    history_mode = check_history(history)
     if scene is not None:
         check_scene_suits(task, scene)
     if planner is None:
@@ -137,7 +145,10 @@ def run(
     agent = make_planner(planner, llm)  # bad names and missing LLM settings fail here, before any work
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
-    spec = EpisodeSpec(task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors)
+    spec = EpisodeSpec(
+        task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
+        descriptions=descriptions, history=history_mode,
+    )
     recorder = open_bag_recorder(bag, bag_storage) if bag is not None else None
     with locked_run_dir(out_dir), console.status(f"running {task} with planner {planner} ..."), recorder or nullcontext():
         check_folder_for(out_dir, spec)

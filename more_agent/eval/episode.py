@@ -119,7 +119,8 @@ def run_episode(
         folder.clear()  # an earlier episode's steps and frames must never show in this one's viewer
     try:
         t = time.perf_counter()
-        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors)
+        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
+                               descriptions=spec.descriptions)
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
@@ -130,7 +131,7 @@ def run_episode(
         t = clock.add("instantiate", t)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
         planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=planner.llm,
+            instance=instance, goals=goals, llm=planner.llm, history=spec.history,
             on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
             trace_graphs=folder is not None and folder.graphs,
         ))
@@ -189,10 +190,11 @@ def ended_abnormally(record: EpisodeRecord) -> bool:
 
 def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     """Draw ``out_dir/map.png`` again from a finished episode's record: the path on the episode's world
-    rebuilt from (task, scene, seed, start, distractors) in its initial state (objects where they started)."""
+    rebuilt from (task, scene, seed, start, distractors, descriptions) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
-    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors)
+    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
+                           descriptions=spec.descriptions)
     EpisodeFolder(out_dir).write_map(record, instance.world, set(instance.scope.values()))
 
 

@@ -112,7 +112,7 @@ def config_specs(config: RunConfig) -> list[EpisodeSpec]:
     return [
         EpisodeSpec(
             task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start,
-            distractors=config.distractors,
+            distractors=config.distractors, descriptions=config.descriptions, history=config.history,
         )
         for t in config.tasks
         for s in config.seeds

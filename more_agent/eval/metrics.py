@@ -6,13 +6,16 @@ Per-episode values:
 - TTC: ``record.all_goals_met`` (all met, whether or not ``done()`` was called).
 - TP: ``record.task_progress`` (share of goal conditions met).
 - rTP: share of met conditions among the *observed* ones. The paper (Sec. IV-A): "share of
-  completed goal conditions that include observed task objects", read literally: a condition is
-  observed when at least one instance in its ``objects`` is in ``record.observed_objects`` (a
-  condition that names no object counts as observed). Requiring *every* instance would never count
-  a condition on a floor or room fixture, which the robot does not observe as an object (see
-  docs/evaluation.md, "rTP"). When an episode observed none of its conditions (or has none), its rTP is
-  **0.0**: the robot never saw what the task is about, so it made no relative progress. This keeps
-  the same n for all four metrics and never rewards a planner for not exploring.
+  completed goal conditions that include observed task objects": a condition is observed when at
+  least one instance in its ``objects`` is in ``record.observed_objects`` (a condition that names no
+  object counts as observed); the others leave the denominator. Requiring *every* instance would
+  never count a condition on a floor or room fixture, which the robot does not observe as an object
+  (see docs/evaluation.md, "rTP"). An episode that observed none of its conditions (or has none) has
+  no rTP (None): it leaves the rTP mean, whose n is then the number of episodes that have one.
+
+rTP is never stored: it is computed from each record's per-condition data (``goal_conditions``,
+``observed_objects``), which every record version holds, so records of older versions get this
+rule too.
 
 Episodes that raised (``record.error`` set) are kept: they count as failures with the values their
 record holds (the harness writes zeros). Aggregates are episode-weighted (each episode counts once;
@@ -57,29 +60,29 @@ def tp(record: EpisodeRecord) -> float:
     return float(record.task_progress)
 
 
-def rtp(record: EpisodeRecord) -> float:
+def rtp(record: EpisodeRecord) -> float | None:
     """Relative task progression: share of met conditions among those that include an observed task object.
 
-    0.0 when no condition was observed (see the module docstring).
+    None when no condition was observed: the episode has no rTP (see the module docstring).
     """
     seen = set(record.observed_objects)
     observed = [c for c in record.goal_conditions if not c.objects or any(o in seen for o in c.objects)]
     if not observed:
-        return 0.0
+        return None
     return sum(c.satisfied for c in observed) / len(observed)
 
 
-PER_EPISODE: dict[str, Callable[[EpisodeRecord], float]] = {"SR": sr, "TTC": ttc, "TP": tp, "rTP": rtp}
-"""Metric name -> per-episode value function."""
+PER_EPISODE: dict[str, Callable[[EpisodeRecord], float | None]] = {"SR": sr, "TTC": ttc, "TP": tp, "rTP": rtp}
+"""Metric name -> per-episode value function (None: the episode has no value of that metric)."""
 
 
 class Estimate(FrozenModel):
-    """A mean over episodes with its 95% confidence interval."""
+    """A mean over the episodes that have a value of the metric, with its 95% confidence interval."""
 
     mean: float = Field(description="Mean over episodes, in [0, 1].")
     low: float = Field(description="Lower end of the 95% interval.")
     high: float = Field(description="Upper end of the 95% interval.")
-    n: int = Field(description="Number of episodes.")
+    n: int = Field(description="Episodes with a value (each has an SR, TTC and TP; not each an rTP).")
     method: Literal["wilson", "bootstrap"] = Field(description="How the interval was computed.")
 
 
@@ -92,7 +95,7 @@ class MetricSummary(FrozenModel):
     SR: Estimate
     TTC: Estimate
     TP: Estimate
-    rTP: Estimate
+    rTP: Estimate | None = Field(description="None when no episode of the group has an rTP (none saw a goal condition).")
 
 
 def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
@@ -120,8 +123,8 @@ def bootstrap_interval(
 
 
 def estimate(records: Sequence[EpisodeRecord], metric: str) -> Estimate:
-    """Mean and 95% interval of one metric ('SR', 'TTC', 'TP', 'rTP') over ``records``."""
-    values = sorted(PER_EPISODE[metric](r) for r in records)  # sorted: the result ignores record order
+    """Mean and 95% interval of one metric ('SR', 'TTC', 'TP', 'rTP') over the ``records`` that have a value."""
+    values = sorted(v for r in records if (v := PER_EPISODE[metric](r)) is not None)  # sorted: order-free
     n = len(values)
     mean = float(np.mean(values)) if n else 0.0
     if metric in ("SR", "TTC"):
@@ -137,7 +140,8 @@ def summarize(records: Sequence[EpisodeRecord]) -> MetricSummary:
         n=len(records),
         n_tasks=len({r.task for r in records}),
         n_errors=sum(r.error is not None for r in records),
-        **{m: estimate(records, m) for m in METRIC_NAMES},
+        **{m: estimate(records, m) for m in METRIC_NAMES if m != "rTP"},
+        rTP=estimate(records, "rTP") if any(rtp(r) is not None for r in records) else None,
     )
 
 

@@ -56,9 +56,13 @@ def load_runs(run_dirs: Sequence[Path]) -> tuple[list[SourcedRecord], int]:
     return out, dropped
 
 
-def fmt(e: Estimate) -> str:
-    """'48.1 [40.2, 55.3]': mean and 95% interval in percent."""
-    return f"{100 * e.mean:.1f} [{100 * e.low:.1f}, {100 * e.high:.1f}]"
+NO_VALUE = "n/a"
+"""Shown for an rTP that no episode of the group has."""
+
+
+def fmt(e: Estimate | None) -> str:
+    """'48.1 [40.2, 55.3]': mean and 95% interval in percent; 'n/a' for None."""
+    return NO_VALUE if e is None else f"{100 * e.mean:.1f} [{100 * e.low:.1f}, {100 * e.high:.1f}]"
 
 
 def md_text(text: str) -> str:
@@ -73,21 +77,23 @@ def _md_table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
-def _cells(s: MetricSummary) -> list[str]:
-    return [fmt(getattr(s, m)) for m in METRIC_NAMES]
+def metric_cells(s: MetricSummary) -> list[str]:
+    """The metric cells of a row; an estimate over fewer episodes than the row's (rTP) says its n."""
+    estimates: list[Estimate | None] = [getattr(s, m) for m in METRIC_NAMES]
+    return [fmt(e) + (f" (n={e.n})" if e is not None and e.n != s.n else "") for e in estimates]
 
 
 def table_i_markdown(records: Sequence[EpisodeRecord]) -> str:
     """Table I: one row per system, SR / TTC / TP / rTP in percent with 95% intervals."""
     header = ["System", "n", "tasks", "errors", *(f"{m} [%]" for m in METRIC_NAMES)]
-    rows = [[k, str(s.n), str(s.n_tasks), str(s.n_errors), *_cells(s)] for k, s in by_system(records).items()]
+    rows = [[k, str(s.n), str(s.n_tasks), str(s.n_errors), *metric_cells(s)] for k, s in by_system(records).items()]
     return _md_table(header, rows)
 
 
 def per_task_markdown(records: Sequence[EpisodeRecord]) -> str:
     """One row per (system, task)."""
     header = ["System", "Task", "n", "errors", *(f"{m} [%]" for m in METRIC_NAMES)]
-    rows = [[k, t, str(s.n), str(s.n_errors), *_cells(s)] for (k, t), s in by_task(records).items()]
+    rows = [[k, t, str(s.n), str(s.n_errors), *metric_cells(s)] for (k, t), s in by_task(records).items()]
     return _md_table(header, rows)
 
 
@@ -108,8 +114,9 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
             f"# {md_text(title)}",
             table_i_markdown(records),
             "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
-            "rTP. Episodes are weighted equally; errored episodes count as failures. rTP is 0 for an "
-            "episode that observed none of its goal conditions' objects.",
+            "rTP. Episodes are weighted equally; errored episodes count as failures. rTP counts the goal "
+            "conditions that name an observed task object; an episode that observed none has no rTP and "
+            "leaves its mean (its n is then given).",
             "## Failure causes",
             failure_markdown(records),
             "## Per task",
@@ -118,13 +125,20 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
     ) + "\n"
 
 
+def _csv_cells(e: Estimate | None) -> list[str]:
+    """Mean, low and high of an estimate; empty cells for None."""
+    return ["", "", ""] if e is None else [f"{v:.6f}" for v in (e.mean, e.low, e.high)]
+
+
 def summary_csv(records: Sequence[EpisodeRecord]) -> str:
-    """summary.csv: one row per system overall (task = 'ALL') and per (system, task)."""
+    """summary.csv: one row per system overall (task = 'ALL') and per (system, task); ``n_rTP``: the
+    episodes that have an rTP (empty rTP cells when none has)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["system", "task", "n", "n_tasks", "n_errors", *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high"))])
+    w.writerow(["system", "task", "n", "n_tasks", "n_errors", *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high")),
+                "n_rTP"])
     rows = [((k, ALL_TASKS), s) for k, s in by_system(records).items()] + list(by_task(records).items())
     for (system, task), s in rows:
-        est = [getattr(s, m) for m in METRIC_NAMES]
-        w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *(f"{v:.6f}" for e in est for v in (e.mean, e.low, e.high))])
+        cells = [c for m in METRIC_NAMES for c in _csv_cells(getattr(s, m))]
+        w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *cells, s.rTP.n if s.rTP is not None else 0])
     return buf.getvalue()

@@ -18,7 +18,7 @@ from urllib.parse import quote
 
 from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
-from more_agent.eval.report import SourcedRecord, fmt
+from more_agent.eval.report import NO_VALUE, SourcedRecord, metric_cells
 from more_agent.eval.store import EPISODE_DIRS, episode_dir, episode_dirname
 from more_agent.records import EpisodeRecord
 
@@ -88,7 +88,7 @@ def _summary_table(rows: list[tuple[list[str], MetricSummary]], head: list[str])
     body = "".join(
         "<tr>"
         + "".join(f"<td>{escape(c)}</td>" for c in [*labels, str(s.n), str(s.n_errors)])
-        + "".join(f"<td>{escape(fmt(getattr(s, m)))}</td>" for m in METRIC_NAMES)
+        + "".join(f"<td>{escape(cell)}</td>" for cell in metric_cells(s))
         + "</tr>"
         for labels, s in rows
     )
@@ -102,13 +102,18 @@ def _status(r: EpisodeRecord) -> str:
     return f'<span class="{cls}">{word}</span>'
 
 
+def _percent(value: float | None) -> str:
+    """'80%', or 'n/a' for no value."""
+    return NO_VALUE if value is None else f"{100 * value:.0f}%"
+
+
 def episode_html(r: EpisodeRecord, run_dir: Path, base: Path) -> str:
     """One episode's collapsible section; links are relative to the report folder ``base``."""
     viewer = episode_file(r, run_dir, VIEWER_FILE)
     viewer_link = f' | <a href="{link(viewer, base)}">viewer</a>' if viewer is not None else ""
     head = (
         f"{_status(r)} {escape(system_label(r))} | {escape(r.task)} | {escape(r.scene or '-')} | seed {r.seed} | "
-        f"TP {100 * r.task_progress:.0f}% rTP {100 * rtp(r):.0f}% | {r.high_level_steps} steps{viewer_link}"
+        f"TP {100 * r.task_progress:.0f}% rTP {_percent(rtp(r))} | {r.high_level_steps} steps{viewer_link}"
     )
     conds = "".join(
         f'<li class="{"ok" if c.satisfied else "fail"}">{"&#10003;" if c.satisfied else "&#10007;"} {escape(c.text)}</li>'

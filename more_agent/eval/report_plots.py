@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from more_agent.eval.metrics import METRIC_NAMES, by_system, by_task, group_by, system_label  # noqa: E402
+from more_agent.eval.metrics import METRIC_NAMES, Estimate, by_system, by_task, group_by, system_label  # noqa: E402
 from more_agent.records import EpisodeRecord  # noqa: E402
 from more_agent.safe_files import write_atomic  # noqa: E402
 
@@ -36,6 +36,8 @@ PLOT_FILES = {
 
 DPI = 100
 _COLOURS = plt.get_cmap("tab10")
+NO_ESTIMATE = Estimate(mean=0.0, low=0.0, high=0.0, n=0, method="bootstrap")
+"""Drawn for a system without an rTP: no bar, 'n/a'."""
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
@@ -55,13 +57,13 @@ def plot_metrics(records: Sequence[EpisodeRecord], path: Path) -> Path:
     fig, axes = plt.subplots(2, 2, figsize=(9, 2 * (0.9 + 0.4 * len(names)) + 0.6), sharey=True, constrained_layout=True)
     y = np.arange(len(names))
     for ax, metric in zip(axes.flat, METRIC_NAMES):
-        est = [getattr(systems[n], metric) for n in names]
+        est = [getattr(systems[n], metric) or NO_ESTIMATE for n in names]
         mean = np.array([100 * e.mean for e in est])
         # clipped at 0: a percentile bootstrap's interval can miss the mean of a tiny, skewed sample
         err = np.clip([[100 * (e.mean - e.low) for e in est], [100 * (e.high - e.mean) for e in est]], 0, None)
         ax.barh(y, mean, xerr=err, color=[_COLOURS(i % 10) for i in range(len(names))], capsize=3, alpha=0.85)
         for yi, m, e in zip(y, mean, est):
-            ax.text(min(100 * e.high + 1.5, 92), yi, f"{m:.0f}", va="center", fontsize=8)
+            ax.text(min(100 * e.high + 1.5, 92), yi, f"{m:.0f}" if e.n else "n/a", va="center", fontsize=8)
         ax.set_xlim(0, 100)
         ax.set_title(f"{metric} [%]", fontsize=10)
         ax.grid(axis="x", alpha=0.3)

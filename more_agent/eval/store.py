@@ -22,7 +22,7 @@ from more_agent.errors import UserError, check_writable_dir
 from more_agent.redaction import redact_tree
 from more_agent.eval.runlock import LOCK_FILE
 from more_agent.record_validation import BadRecord, parse_record, record_json
-from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.records import DEFAULT_HISTORY, LEGACY_DESCRIPTIONS, EpisodeRecord, EpisodeSpec, HistoryMode, legacy_history
 from more_agent.safe_files import open_nofollow, read_bounded, write_atomic
 
 EPISODES_FILE = "episodes.jsonl"
@@ -44,6 +44,10 @@ class RunConfig(BaseModel):
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
     start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
     distractors: bool = Field(default=True, description="Whether every episode's world holds the scene's own small objects.")
+    descriptions: str = Field(
+        default="named", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions)."
+    )
+    history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
@@ -54,7 +58,9 @@ class RunConfig(BaseModel):
     )
 
 
-MIXING_FIELDS = ("planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "episode_fn")
+MIXING_FIELDS = (
+    "planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "descriptions", "history", "episode_fn",
+)
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 
@@ -69,8 +75,12 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     planners = sorted({r.planner for r in records})
     llms = sorted({str(r.llm) for r in records})
     starts = sorted({r.start for r in records})
+    histories = sorted({r.history for r in records})
+    descriptions = sorted({r.descriptions for r in records})
     return config.model_copy(update={
         "start": starts[0] if len(starts) == 1 else ",".join(starts),
+        "history": histories[0] if len(histories) == 1 else ",".join(histories),
+        "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
         "planner": planners[0] if len(planners) == 1 else ",".join(planners),
         "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
         "tasks": sorted({r.task for r in records} | set(config.tasks)),
@@ -209,14 +219,15 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
 
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
     """The specs with no record yet, in order: a record counts for a spec when it shares task, seed,
-    planner, LLM, start and distractors (a record that predates the distractors field matches either)
-    and scene (a record of a scene file's scene counts for the file)."""
-    done: dict[tuple[str, int, str, str | None, str], list[EpisodeRecord]] = {}
+    planner, LLM, start, description mode, history and distractors (a record that predates the distractors
+    field matches either) and scene (a record of a scene file's scene counts for the file)."""
+    done: dict[tuple[str, int, str, str | None, str, str, str], list[EpisodeRecord]] = {}
     for r in records:
-        done.setdefault((r.task, r.seed, r.planner, r.llm, r.start), []).append(r)
+        done.setdefault((r.task, r.seed, r.planner, r.llm, r.start, r.descriptions, r.history), []).append(r)
     out = []
     for s in specs:
-        scenes = {r.scene for r in done.get((s.task, s.seed, s.planner, s.llm, s.start), [])
+        key = (s.task, s.seed, s.planner, s.llm, s.start, s.descriptions, s.history)
+        scenes = {r.scene for r in done.get(key, [])
                   if r.distractors in (None, s.distractors)}
         if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
@@ -238,11 +249,13 @@ def _scene_name(scene: str) -> str:
 
 def episode_dirname(
     task: str, scene: str | None, seed: int, planner: str, *,
-    llm: str | None = None, start: str = "random", distractors: bool | None = True,
+    llm: str | None = None, start: str = "random", distractors: bool | None = True, descriptions: str = "named",
+    history: str = "paper",
 ) -> str:
     """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
 
-    The LLM, a start other than 'random' and ``--no-distractors`` are part of the name, so that the
+    The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
+    a history other than 'paper' are part of the name, so that the
     episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a folder.
     """
     parts = [task, scene or "auto", f"s{seed}", planner]
@@ -252,13 +265,18 @@ def episode_dirname(
         parts.append(start)
     if distractors is False:
         parts.append("nodistractors")
+    if descriptions != "named":
+        parts.append(f"{descriptions}-descriptions")
+    if history != "paper":
+        parts.append(f"{history}-history")
     return re.sub(r"[^A-Za-z0-9_.\-]", "_", "__".join(parts))
 
 
 def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str | None = None) -> Path:
     """The folder of ``episode``'s files in the run folder ``run_dir`` (``scene`` in place of its own)."""
     name = episode_dirname(episode.task, scene if scene is not None else episode.scene, episode.seed, episode.planner,
-                           llm=episode.llm, start=episode.start, distractors=episode.distractors)
+                           llm=episode.llm, start=episode.start, distractors=episode.distractors,
+                           descriptions=episode.descriptions, history=episode.history)
     return Path(run_dir) / EPISODE_DIRS / name
 
 
@@ -268,12 +286,18 @@ def write_run_config(run_dir: Path, config: RunConfig) -> None:
 
 
 def read_run_config(run_dir: Path) -> RunConfig | None:
-    """The run's configuration, or None if ``run.json`` is missing."""
+    """The run's configuration, or None if ``run.json`` is missing. A ``run.json`` written before the
+    history option gets the history its episodes ran with (:func:`~more_agent.records.legacy_history`)."""
     path = Path(run_dir) / RUN_FILE
     if not path.exists():
         return None
     try:
-        return RunConfig.model_validate(json.loads(read_bounded(path, what="run configuration")))
+        data = json.loads(read_bounded(path, what="run configuration"))
+        if isinstance(data, dict) and "history" not in data:
+            data = legacy_history(data)
+        if isinstance(data, dict) and "descriptions" not in data:
+            data = {**data, "descriptions": LEGACY_DESCRIPTIONS}
+        return RunConfig.model_validate(data)
     except (ValueError, ValidationError, RecursionError) as e:
         raise UserError(f"{path} is not a valid run configuration: {e}") from None
 
@@ -292,8 +316,8 @@ def prepare_run_dir(
     """Create or reopen a run directory and return the records already in it.
 
     Without ``resume`` a non-empty directory is refused. With ``resume`` the planner, LLM, tasks,
-    seeds, scene, start mode and episode function must match the stored ``run.json`` (or, when it is missing,
-    the records), unless ``allow_mixed``; a torn last line is truncated.
+    seeds, scene, start mode, distractors, history and episode function must match the stored
+    ``run.json`` (or, when it is missing, the records), unless ``allow_mixed``; a torn last line is truncated.
     """
     run_dir = Path(run_dir)
     check_run_dir(run_dir)

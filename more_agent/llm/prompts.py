@@ -15,14 +15,16 @@ from importlib import resources
 from string import Template
 from typing import Protocol
 
+from more_agent.errors import UserError, unknown_name_error
 from more_agent.llm.completion import ChatMessage
+from more_agent.records import DEFAULT_HISTORY, HISTORY_MODES, HistoryMode
 from more_agent.skills import SKILLS, Skill
 
 PROMPT_NAMES = ("room", "filter", "plan")
 VLM_PROMPT_NAMES = ("bumble_plan", "bumble_landmark", "bumble_object", "bumble_explore", "bumble_verify")
 """The BUMBLE baselines' prompts (:mod:`more_agent.planners.vlm_prompts` builds their messages with images)."""
 HISTORY_LAST_N = 5
-"""The planner sees the last five actions plus all failed ones (paper Sec. III-C), and every lasting success."""
+"""The planner sees the last five actions plus all failed ones (paper Sec. III-C)."""
 
 _SECTION = re.compile(r"^\[\[(system|user|assistant)\]\]\s*$", re.M)
 
@@ -76,18 +78,31 @@ def skill_api_text(skills: Iterable[Skill], *, vlm: bool = False) -> str:
 
 
 LASTING_SKILLS = frozenset(s.name for s in SKILLS if s.changes_world)
-"""Skills whose success changes the world until undone: the history keeps them beyond the last five."""
+"""Skills whose success changes the world until undone: the ``lasting`` history keeps them beyond the last five."""
 
 
-def history_text(actions: Sequence[HistoryItem], last_n: int = HISTORY_LAST_N) -> str:
-    """The last ``last_n`` actions plus all earlier failed ones (the paper's history) and all earlier
-    successful grasps, placements, openings and closings (what the robot did stays true, and a
-    planner that forgets it redoes it), numbered, in order, each with its feedback (which names the
-    objects: 'placed hammer A inside toolbox A'); 'none' if empty."""
+def check_history(mode: str) -> HistoryMode:
+    """``mode`` as a history mode; a UserError naming the valid ones otherwise."""
+    for m in HISTORY_MODES:
+        if mode == m:
+            return m
+    raise UserError(f"{unknown_name_error('history', mode, HISTORY_MODES)}; use --history with one of: "
+                    f"{', '.join(HISTORY_MODES)}")
+
+
+def history_text(
+    actions: Sequence[HistoryItem], mode: HistoryMode = DEFAULT_HISTORY, last_n: int = HISTORY_LAST_N
+) -> str:
+    """The action history, numbered, in order, each action with its feedback (which names the objects:
+    'placed hammer A inside toolbox A'); 'none' if empty.
+
+    ``paper``: the last ``last_n`` actions plus all earlier failed ones (paper Sec. III-C); what the
+    robot did shows in the scene text (held item, placed items, open or closed). ``lasting`` (our
+    extension): also all earlier successful grasps, placements, openings and closings."""
     first_recent = max(0, len(actions) - last_n)
     lines = []
     for i, a in enumerate(actions):
-        if i >= first_recent or not a.ok or a.name in LASTING_SKILLS:
+        if i >= first_recent or not a.ok or (mode == "lasting" and a.name in LASTING_SKILLS):
             detail = f": {a.feedback}" if a.feedback else ""
             outcome = f"succeeded{detail}" if a.ok else f"failed{detail}"
             lines.append(f"{i + 1}. {a.name}({', '.join(a.arguments)}) -> {outcome}")
@@ -113,6 +128,7 @@ def plan_messages(
     history: Sequence[HistoryItem],
     feedback: str,
     skills: Sequence[Skill] = SKILLS,
+    history_mode: HistoryMode = DEFAULT_HISTORY,
 ) -> list[ChatMessage]:
     """Planning prompt (paper Fig. 4) for the filtered scene text and the robot's state."""
     return render_prompt(
@@ -122,6 +138,6 @@ def plan_messages(
         skills=skill_api_text(skills),
         robot_room=robot_room,
         held_object=held_object or "nothing",
-        history=history_text(history),
+        history=history_text(history, history_mode),
         feedback=feedback or "none",
     )

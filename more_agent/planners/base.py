@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
 from more_agent.errors import UserError, unknown_name_error
-from more_agent.records import LLMUsage
+from more_agent.records import DEFAULT_HISTORY, HistoryMode, LLMUsage
 
 if TYPE_CHECKING:
     from more_agent.planners.policies.embodiment import Embodiment
@@ -76,6 +76,8 @@ class EpisodeContext:
     """Privileged goal access: only the oracle may read it (LLM planners get ``instance.description``)."""
     llm: str | None = None
     """LLM spec such as 'openai:gpt-4o', for planners that need one."""
+    history: HistoryMode = DEFAULT_HISTORY
+    """Which action history the LLM and VLM planners show (``more_agent.llm.prompts.history_text``)."""
     on_frame: Callable[[Frame], None] | None = None
     """Called with every frame the robot renders (the episode folder writes them with ``--save-frames``)."""
     trace_graphs: bool = False

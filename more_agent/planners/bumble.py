@@ -68,7 +68,7 @@ from more_agent.planners.vlm_prompts import (
     parse_verdict,
     step_messages,
 )
-from more_agent.records import ActionRecord, LLMUsage
+from more_agent.records import DEFAULT_HISTORY, ActionRecord, HistoryMode, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
@@ -155,6 +155,7 @@ class BumblePlanner:
         self.memory = VisualMemory(config.memory)
         self.task = ""
         self.history: list[ActionRecord] = []
+        self.history_mode: HistoryMode = DEFAULT_HISTORY
         self.subtasks: list[str] = []
         """The subtask of each action in ``history``."""
         self.feedback = ""
@@ -183,7 +184,7 @@ class BumblePlanner:
 
         self.body.on_frame = on_frame
         self.task = context.instance.description
-        self.history, self.subtasks, self.feedback = [], [], ""
+        self.history, self.subtasks, self.feedback, self.history_mode = [], [], "", context.history
         self.calls.new_episode()
         self.body.sense()
         self.body.look_around()
@@ -281,7 +282,7 @@ class BumblePlanner:
         held = graph.held_object
         return step_messages(
             task=self.task, view=view, objects=objects, held=held.label if held is not None else None, history=past,
-            feedback=self.feedback,
+            feedback=self.feedback, history_mode=self.history_mode,
         )
 
     def _object_target(self, subtask: str) -> Decision:

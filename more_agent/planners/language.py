@@ -2,19 +2,22 @@
 
 A :class:`SceneView` is the language-side picture of one :class:`~more_agent.scene_graph.SceneGraph`:
 rooms (regions named by their LLM room label, ``kitchen_0``), each with its objects (alphabetical
-instance ids such as ``fridge A``, or bare classes for MoMa-LLM), their attributes (open / closed),
-optional spatial relations (``inside fridge A``, ``on top of table B``), whether the room still has
-unexplored areas, and the robot's room and held object. The same view renders the text, lists the
+instance ids such as ``fridge A``, or bare classes for MoMa-LLM), their attributes (open / closed,
+held by the robot), optional spatial relations (``inside fridge A``, ``on top of table B``), whether
+the room still has unexplored areas, and the robot's room and held object. The same view renders the text, lists the
 valid names for answer validation, applies the LLM filter (paper Sec. III-B, ``xi -> xi_task``) and
 resolves the names in an answer back to scene-graph object ids.
 
 Text format, one line per room (attributes in brackets, as the prompts announce); each room lists
-its ``floor`` first, so that goals on floors can be expressed (``go_to_and_place_ontop(kitchen_0, floor)``)::
+its ``floor`` first, so that goals on floors can be expressed (``go_to_and_place_ontop(kitchen_0, floor)``),
+and the object in the robot's hand in the robot's room::
 
-    kitchen_0 (unexplored areas): floor, apple A [inside fridge A], fridge A [closed], table A
+    kitchen_0 (unexplored areas): floor, apple A [inside fridge A], book A [held by the robot], fridge A [closed], table A
 
-Relations are those of the scene graph: as perceived (where the world put things), not guessed
-from boxes, for the simulator's instances.
+What the robot did is visible in the text itself, as the paper's history (the last five actions and
+the failed ones) needs: what it holds, where each item it put down rests (with spatial relations)
+and whether each openable is open. Relations are those of the scene graph: as perceived (where the
+world put things), not guessed from boxes, for the simulator's instances.
 """
 
 from __future__ import annotations
@@ -35,6 +38,9 @@ FLOOR = "floor"
 
 UNKNOWN_PLACE = "unknown"
 """Robot room shown when the robot is not in any region of the graph."""
+
+HELD = "held by the robot"
+"""Attribute of the held object, listed in the robot's room."""
 
 
 class LanguageOptions(BaseModel):
@@ -61,11 +67,14 @@ class ObjectText:
     """'open', 'closed', or None when not openable."""
     relation: tuple[str, str] | None = None
     """('inside' or 'on top of', name of the container / support), when relations are shown."""
+    held: bool = False
+    """The robot holds it (it is listed in the robot's room)."""
 
     def text(self) -> str:
         """E.g. ``apple A [inside fridge A]``, or ``cabinet (x2) [closed]`` for merged class entries."""
         count = f" (x{len(self.ids)})" if len(self.ids) > 1 else ""
-        attrs = ([self.state] if self.state else []) + ([" ".join(self.relation)] if self.relation else [])
+        attrs = ([self.state] if self.state else []) + ([HELD] if self.held else [])
+        attrs += [" ".join(self.relation)] if self.relation else []
         bracket = f" [{', '.join(attrs)}]" if attrs else ""
         return f"{self.name}{count}{bracket}"
 
@@ -146,12 +155,12 @@ class SceneView:
 
     def filtered(self, kept: FilterResult, *, always: Collection[str] = ()) -> SceneView:
         """The task subgraph: the rooms the filter kept (plus ``always``, e.g. the robot's room), each
-        with its kept objects plus the containers / supports their relations name."""
+        with its kept objects, the held object and the containers / supports their relations name."""
         rooms = []
         for r in self.rooms:
             if r.name not in kept.rooms and r.name not in always:
                 continue
-            keep = set(kept.rooms.get(r.name, ())) | {FLOOR}
+            keep = set(kept.rooms.get(r.name, ())) | {FLOOR} | {o.name for o in r.objects if o.held}
             keep |= {o.relation[1] for o in r.objects if o.name in keep and o.relation is not None}
             rooms.append(replace(r, objects=tuple(o for o in r.objects if o.name in keep)))
         return replace(self, rooms=tuple(rooms))
@@ -159,7 +168,8 @@ class SceneView:
 
 def scene_view(graph: SceneGraph, options: LanguageOptions, names: Mapping[str, str] | None = None) -> SceneView:
     """The language view of ``graph`` under ``options``; ``names`` maps region ids to room names
-    (default :func:`room_names`)."""
+    (default :func:`room_names`). The held object is listed in the robot's room (nowhere when the
+    robot stands in no region; the robot line of the prompts names it anyway)."""
     names = dict(names) if names is not None else room_names(graph)
     shown = {oid: _shown_name(obj, options) for oid, obj in graph.objects.items()}
     relation_of: dict[str, tuple[str, str]] = {}
@@ -167,15 +177,15 @@ def scene_view(graph: SceneGraph, options: LanguageOptions, names: Mapping[str, 
         for rel in graph.relations:
             if rel.subject in shown and rel.object in shown:
                 relation_of[rel.subject] = ("inside" if rel.predicate == "inside" else "on top of", shown[rel.object])
+    held = graph.held_object
     rooms = []
     for rid in sorted(graph.regions, key=lambda r: names[r]):
         region = graph.regions[rid]
-        objects = graph.objects_in(rid)
-        entries = _merge([(shown[o.id], o.id, _state(o), relation_of.get(o.id)) for o in objects])
+        objects = graph.objects_in(rid) + ([held] if held is not None and rid == graph.robot.region_id else [])
+        entries = _merge([(shown[o.id], o.id, _state(o), relation_of.get(o.id), o.held) for o in objects])
         if options.floors:
             entries = (ObjectText(name=FLOOR, ids=()), *entries)
         rooms.append(RoomText(name=names[rid], region_id=rid, objects=entries, unexplored=bool(region.frontiers)))
-    held = graph.held_object
     robot_room = names.get(graph.robot.region_id or "", UNKNOWN_PLACE)
     return SceneView(
         rooms=tuple(rooms), robot_room=robot_room, held=shown[held.id] if held is not None else None,
@@ -191,17 +201,17 @@ def _state(obj: ObjectNode) -> str | None:
     return None if obj.open is None else ("open" if obj.open else "closed")
 
 
-_Entry = tuple[str, str, str | None, tuple[str, str] | None]
-"""(shown name, object id, state, relation) of one object."""
+_Entry = tuple[str, str, str | None, tuple[str, str] | None, bool]
+"""(shown name, object id, state, relation, held) of one object."""
 
 
 def _merge(entries: Iterable[_Entry]) -> tuple[ObjectText, ...]:
-    """One ObjectText per distinct (name, state, relation), sorted: instance labels stay single,
+    """One ObjectText per distinct (name, state, relation, held), sorted: instance labels stay single,
     class names with equal attributes merge into one counted entry."""
-    groups: dict[tuple[str, str, tuple[str, str] | tuple[()]], list[str]] = {}
-    for name, oid, state, relation in entries:
-        groups.setdefault((name, state or "", relation or ()), []).append(oid)
+    groups: dict[tuple[str, str, tuple[str, str] | tuple[()], bool], list[str]] = {}
+    for name, oid, state, relation, held in entries:
+        groups.setdefault((name, state or "", relation or (), held), []).append(oid)
     return tuple(
-        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None)  # type: ignore[arg-type]
-        for (n, s, r), ids in sorted(groups.items())
+        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None, held=h)  # type: ignore[arg-type]
+        for (n, s, r, h), ids in sorted(groups.items())
     )

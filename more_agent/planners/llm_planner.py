@@ -3,8 +3,9 @@
 One high-level step (paper Sec. III-B/C, MPC style): build the scene graph from everything sensed,
 label new regions with the cheaper room model, put the graph into words, let the LLM filter it to
 the task-relevant subgraph (MORE only), ask the LLM for one subpolicy call given the task, the
-subgraph, the robot's room and held object, the history (last five actions and every failed one)
-and the last feedback, then run that subpolicy. Planners differ only in their
+subgraph, the robot's room and held object, the history (last five actions and every failed one,
+the paper's; ``lasting`` also keeps every earlier successful grasp, place, open and close) and the last
+feedback, then run that subpolicy. Planners differ only in their
 :class:`LLMPlannerConfig`:
 
 - ``more``: filtering, alphabetical instance ids, spatial relations;
@@ -55,7 +56,7 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
-from more_agent.records import ActionRecord, LLMUsage
+from more_agent.records import DEFAULT_HISTORY, ActionRecord, HistoryMode, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.skills import SKILLS, SKILLS_BY_NAME
@@ -140,6 +141,7 @@ class LLMPlanner:
         self.body: Embodiment | None = None
         self.task = ""
         self.history: list[ActionRecord] = []
+        self.history_mode: HistoryMode = DEFAULT_HISTORY
         self.feedback = ""
         self.graph: SceneGraph | None = None
         self.view: SceneView | None = None
@@ -153,7 +155,7 @@ class LLMPlanner:
         self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping,
                                on_frame=context.on_frame)
         self.task = context.instance.description
-        self.history, self.feedback = [], ""
+        self.history, self.history_mode, self.feedback = [], context.history, ""
         self.calls.new_episode()
         self.body.sense()
         self.body.look_around()
@@ -176,7 +178,7 @@ class LLMPlanner:
         planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
         messages = plan_messages(
             task=self.task, scene=planning_view.text(), robot_room=view.robot_room, held_object=view.held,
-            history=self.history, feedback=self.feedback,
+            history=self.history, feedback=self.feedback, history_mode=self.history_mode,
         )
         rooms, objects = [r.name for r in view.rooms], view.object_names()
         try:

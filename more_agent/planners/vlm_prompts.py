@@ -22,6 +22,7 @@ from more_agent.llm.completion import ChatMessage
 from more_agent.llm.errors import InvalidAnswer
 from more_agent.llm.images import image_part, text_part
 from more_agent.llm.prompts import history_text, render_prompt, skill_api_text
+from more_agent.records import DEFAULT_HISTORY, HistoryMode
 from more_agent.skills import SKILLS
 
 
@@ -88,12 +89,13 @@ def frame_captions(objects_per_frame: Sequence[Sequence[str]]) -> list[str]:
 
 
 def step_messages(
-    *, task: str, view: Picture, objects: Sequence[str], held: str | None, history: Sequence[Any], feedback: str
+    *, task: str, view: Picture, objects: Sequence[str], held: str | None, history: Sequence[Any], feedback: str,
+    history_mode: HistoryMode = DEFAULT_HISTORY,
 ) -> list[ChatMessage]:
     """The step decision: task, annotated current view and its marked objects, memories, skills."""
     messages = render_prompt(
         "bumble_plan", task=task, skills=skill_api_text(SKILLS, vlm=True), objects=object_list(objects),
-        held_object=held or "nothing", history=history_text(history), feedback=feedback or "none",
+        held_object=held or "nothing", history=history_text(history, history_mode), feedback=feedback or "none",
     )
     return with_pictures(messages, [view])
 

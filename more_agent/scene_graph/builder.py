@@ -1,11 +1,11 @@
 """``SceneGraphBuilder``: fuses frames incrementally and builds a ``SceneGraph`` per high-level step.
 
 ``integrate`` (every frame) only updates the voxel map and per-instance bookkeeping (attributes,
-viewpoints). ``build`` (once per step) runs the graph pipeline ``mapping.region_graph`` on the BEV
-(Voronoi graph -> sparsification -> door cuts -> regions (+ sub-region merging) -> Eq. 1 object
-assignment -> frontiers), then gives regions stable ids, reduces everything to the robot's
-navigable component and adds the spatial relations (as perceived where the instance information
-says how an object rests, from box geometry otherwise).
+viewpoints, what rides on the held object). ``build`` (once per step) runs the graph pipeline
+``mapping.region_graph`` on the BEV (Voronoi graph -> sparsification -> door cuts -> regions
+(+ sub-region merging) -> Eq. 1 object assignment -> frontiers), then gives regions stable ids,
+reduces everything to the robot's navigable component and adds the spatial relations (as perceived
+where the instance information says how an object rests, from box geometry otherwise).
 
 Region ids: each region keeps an anchor point; at the next build a region inherits the id of the
 old anchor(s) whose nearest node (within ``2 * sparsify_threshold_m``) it contains, the smallest
@@ -67,6 +67,8 @@ class SceneGraphBuilder:
         self._viewpoints: dict[int, dict[tuple[int, int], tuple[float, float]]] = {}
         self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._remembered: set[int] = set()
+        self._carried: set[int] = set()
+        """Instances resting on or in the held one (directly or through others): they travel with it."""
         self._glimpsed: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         """Instance id -> box of its pixels when last in view small (used while the voxel map has none of it)."""
         self._anchors: dict[str, np.ndarray] = {}
@@ -89,7 +91,9 @@ class SceneGraphBuilder:
         robot position it was seen from. A newly held instance leaves the voxel map, and so does a
         door whose open state changed: rays through an opening pass above the lower part of a leaf
         seen closed and never clear it, so the doorway would stay blocked (and the room behind
-        unexplored) for good; the cleared cells become frontiers until the room behind is seen."""
+        unexplored) for good; the cleared cells become frontiers until the room behind is seen. The
+        door itself stays in the graph at its last box, in its new state, until a frame shows it
+        again (the robot that opened it knows it is open)."""
         for iid, info in instances.items():
             previous = self._instances.get(iid)
             if info.held and not (previous is not None and previous.held):
@@ -100,9 +104,14 @@ class SceneGraphBuilder:
                 self._remembered.discard(iid)
                 self._glimpsed.pop(iid, None)
             if info.category == "door" and previous is not None and previous.open is not None and info.open != previous.open:
-                self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks (or is new)
+                removed = self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks
+                if len(removed):  # ... but the door is still there, in the state the robot knows, until seen again
+                    self._set_box(iid, removed)
+                if iid in self._boxes:
+                    self._remembered.add(iid)
             self._instances[iid] = info
-        held = [iid for iid, info in self._instances.items() if info.held]
+        self._pick_up_contents()
+        held = [iid for iid, info in self._instances.items() if info.held] + sorted(self._carried)
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
         self._glimpse(depth, instance, K, T_world_cam, held)
         xy = (float(robot_xy[0]), float(robot_xy[1]))
@@ -110,6 +119,32 @@ class SceneGraphBuilder:
         for iid in np.unique(instance[np.isfinite(depth)]).tolist():
             if iid > 0:
                 self._viewpoints.setdefault(iid, {})[key] = xy
+
+    def _pick_up_contents(self) -> None:
+        """Update which instances ride on the held one (perception says what each rests on / in). Newly
+        carried ones leave the voxel map like the held one (seen in the robot's hand, they would map as
+        an obstacle where the robot stands) and are kept in the graph, travelling with the robot."""
+        by_label = {info.label: iid for iid, info in self._instances.items()}
+        carried = set()
+        holding = any(info.held for info in self._instances.values())
+        for iid, info in self._instances.items() if holding else ():
+            chain = info
+            for _ in range(len(by_label)):  # up the supports, as far as the held object (cycles end it)
+                support = by_label.get(chain.rests[1]) if chain.rests is not None and chain.rests[1] else None
+                if support is None:
+                    break
+                chain = self._instances[support]
+                if chain.held:
+                    carried.add(iid)
+                    break
+        for iid in carried - self._carried:
+            removed = self.voxels.clear_instance(iid)
+            if len(removed):
+                self._set_box(iid, removed)
+            self._glimpsed.pop(iid, None)
+            if iid in self._boxes:
+                self._remembered.add(iid)
+        self._carried = carried
 
     def remember(self, iid: int, box_min: Sequence[float], box_max: Sequence[float]) -> None:
         """An instance the robot put down itself: kept in the graph with this box (world metres) while
@@ -143,6 +178,10 @@ class SceneGraphBuilder:
         known = sorted(i for i in set(voxels) | self._remembered | set(self._glimpsed) if i in self._instances)
         doors = [voxels[i][:, :2] for i in known if i in voxels and self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
+        for i in self._carried & set(objects):  # with the robot
+            lo, hi = self._boxes[i]
+            shift = np.array([robot[0], robot[1], 0.0]) - np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.0])
+            self._boxes[i] = (lo + shift, hi + shift)
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
         rg = region_graph(occ, grid, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
@@ -283,7 +322,8 @@ class SceneGraphBuilder:
                 nav_nodes=sub_index[members].tolist(), frontiers=fr,
             )
 
-        relations = self._relations([o for o in obj_nodes.values() if o.category != "door" and not o.held])
+        relations = self._relations([o for o in obj_nodes.values() if o.category != "door" and not o.held],
+                                    held={o.id for o in obj_nodes.values() if o.held})
 
         robot_node = -1
         labelled_kept = np.flatnonzero(keep & (labels >= 0))
@@ -301,10 +341,11 @@ class SceneGraphBuilder:
             occupancy=OccupancyMap(grid=occ, origin_xy=grid.origin_xy, resolution_m=grid.resolution_m),
         )
 
-    def _relations(self, placed: list[ObjectNode]) -> list[Relation]:
+    def _relations(self, placed: list[ObjectNode], held: set[str]) -> list[Relation]:
         """Spatial relations among the placed objects: as perceived where perception reports how an
-        object rests (what the world did), from box geometry for the others."""
-        ids = {o.id for o in placed}
+        object rests (what the world did; on or in the ``held`` object for what the robot carries
+        with it), from box geometry for the others."""
+        ids = {o.id for o in placed} | held
         relations = []
         for o in placed:
             rests = self._instances[o.instance_id].rests

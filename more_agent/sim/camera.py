@@ -6,10 +6,11 @@ camera coordinates to world coordinates. Pixel (u, v) has its centre at integer 
 ``K @ p_cam / p_cam[2]`` gives column / row indices directly and the principal point of a
 symmetric image is ((W - 1) / 2, (H - 1) / 2).
 
-Geometry (see docs/sensors.md for the reasons): 256 x 256 pixels, 90 degrees horizontal field of
-view with square pixels (so 90 degrees vertically too), mounted 1.2 m above the ground (the Fetch
-head camera with the torso lowered) and pitched 20 degrees down, 5 m range. With these values the
-ground is visible from 0.56 m in front of the robot and a 2.1 m door lintel from 1.9 m away.
+Geometry (see docs/sensors.md for the reasons): 256 x 256 pixels, the field of view of OmniGibson's
+Fetch head camera (63.3 degrees horizontally, :data:`HFOV_DEG`) with square pixels (so 63.3 degrees
+vertically too), mounted 1.2 m above the ground (the Fetch head camera with the torso lowered) and
+pitched 20 degrees down, 5 m range. With these values the ground is visible from 0.95 m in front of
+the robot and a 2.1 m door lintel from 4.4 m away.
 """
 
 from __future__ import annotations
@@ -22,8 +23,14 @@ import numpy as np
 IMAGE_SIZE = 256
 """Width and height of every frame in pixels (paper S.2)."""
 
-HFOV_DEG = 90.0
-"""Horizontal field of view in degrees."""
+OMNIGIBSON_FOCAL_LENGTH_MM = 17.0
+"""Focal length OmniGibson's ``VisionSensor`` sets on every robot camera, the Fetch's head camera included."""
+
+USD_HORIZONTAL_APERTURE_MM = 20.955
+"""Horizontal aperture of a USD camera that sets none (OmniGibson leaves the USD default)."""
+
+HFOV_DEG = math.degrees(2 * math.atan(USD_HORIZONTAL_APERTURE_MM / (2 * OMNIGIBSON_FOCAL_LENGTH_MM)))
+"""Horizontal field of view in degrees: the paper's Fetch in OmniGibson, 63.3 degrees."""
 
 PITCH_DEG = 20.0
 """Fixed downward tilt of the optical axis below the horizon, in degrees."""
@@ -50,6 +57,13 @@ class Camera:
     def focal_px(self) -> float:
         """Focal length in pixels (square pixels: fx = fy)."""
         return (self.width / 2) / math.tan(math.radians(self.hfov_deg) / 2)
+
+    @property
+    def blind_floor_m(self) -> float:
+        """Distance from the camera's foot within which the floor lies below the image's bottom edge:
+        the robot never sees the floor this close to it (0.95 m with the default geometry)."""
+        half_vfov = math.atan((self.height / 2) / self.focal_px)
+        return self.height_m / math.tan(math.radians(self.pitch_deg) + half_vfov)
 
     def intrinsics(self) -> np.ndarray:
         """The 3x3 intrinsic matrix K (float64)."""

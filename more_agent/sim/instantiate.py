@@ -3,7 +3,9 @@
 Steps (all deterministic for a given task, scene and seed):
 1. Scopes bound by ``inroom`` literals take existing scene objects: per room type, the first room
    of that type (scene order) where every such scope gets its own piece of furniture of a matching
-   category (bipartite matching); ``floor.n.01_k`` takes that room's floor.
+   category (bipartite matching); ``floor.n.01_k`` takes that room's floor. Wall fixtures the plan
+   leaves out (wall nails, hooks, mirrors, ...) are hung first where bddl lists them and a scope
+   needs their category (``sim.fixtures``).
 2. ``agent.n.01_1`` stands for the robot; substances and ``future`` objects are virtual scopes.
 3. Every other scope becomes a new item: category from the synset (the synset's own category when
    it has one, else one drawn with the seed), size from the catalogue, name from the scope
@@ -28,7 +30,6 @@ Steps (all deterministic for a given task, scene and seed):
 
 from __future__ import annotations
 
-import re
 import time
 import zlib
 from dataclasses import dataclass, field
@@ -39,8 +40,11 @@ from bddl.condition_evaluation import compile_state
 
 from more_agent.errors import UserError
 from more_agent.sim import catalog
+from more_agent.sim.ambiguity import SCOPE_WORD
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
+from more_agent.sim.descriptions import check_description_mode, description_template
+from more_agent.sim.fixtures import hang_listed_fixtures
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
@@ -50,8 +54,8 @@ from more_agent.sim.tasks import (
     TaskDefinition,
     category_phrase,
     check_scene_suits,
-    describe_goal,
     draw_scenes,
+    literal_text,
     load_task,
     scope_synset,
 )
@@ -103,6 +107,10 @@ class TaskInstance:
     """World names of the scene's own small objects added as items (``sim.clutter``)."""
     start: StartFacts | None = None
     """Start room, task rooms and start-to-task path length at the start."""
+    descriptions: str = "named"
+    """How the description was written (``descriptions.DESCRIPTION_MODES``)."""
+    description_template: str = ""
+    """The description with ``$scope`` words where it names instances (``descriptions.description_template``)."""
 
     def scope_objects(self) -> dict[str, ScopeObject]:
         """The filled bddl scope: every entry a ``ScopeObject``."""
@@ -120,16 +128,19 @@ class TaskInstance:
 
 def instantiate(
     task: str, scene: str | None = None, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate ``task`` with ``seed`` in a scene generated with that seed.
 
     Without ``scene``, the scene is drawn with the seed among the task's suitable ones
     (``tasks.draw_scenes``; the next in the draw is tried when one cannot hold the task); a named
     scene must suit the task (scene .json files are taken as they are). ``start`` is one of
-    ``START_MODES``; ``distractors`` adds the scene's own small objects (``sim.clutter``).
+    ``START_MODES``; ``distractors`` adds the scene's own small objects (``sim.clutter``);
+    ``descriptions`` is one of ``DESCRIPTION_MODES``.
     """
     t0 = time.perf_counter()
     check_start(start)
+    check_description_mode(descriptions)
     definition = load_task(task)
     t_parse = time.perf_counter() - t0
     if scene is None:
@@ -147,7 +158,8 @@ def instantiate(
         scene_obj = get_scene(name, seed)
         t_scene = time.perf_counter() - t1
         try:
-            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors)
+            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors,
+                                            descriptions=descriptions)
         except InstantiationError as e:
             if scene is not None:
                 raise InstantiationError(f"{e} (scene {name}, seed {seed}); choose another --seed or --scene") from None
@@ -163,6 +175,7 @@ def instantiate(
 
 def instantiate_in_scene(
     definition: TaskDefinition | str, scene: Scene, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate a task in a given ``Scene`` object (hand-built scenes included)."""
     if isinstance(definition, str):
@@ -188,7 +201,7 @@ def instantiate_in_scene(
         task=definition.name, scene=scene.name, seed=seed, world=world, description="",
         scope=builder.scope, virtual_scopes=sorted(builder.virtual), unsupported_literals=builder.unsupported,
         timings={}, definition=definition, start_mode=start, distractors=clutter.items,
-        start=start_facts(world, targets),
+        start=start_facts(world, targets), descriptions=descriptions,
     )
     _verify_init(instance)
     instance.description = task_description(instance)
@@ -197,15 +210,14 @@ def instantiate_in_scene(
 
 
 def task_description(instance: TaskInstance) -> str:
-    """The paper's description with ``$scope`` words replaced by labels, else one generated from the goal.
+    """The description of ``descriptions.description_template`` with ``$scope`` words replaced by labels.
 
     The instances it names get their labels here, before the episode, so that the description and
     the scene text agree; every other instance is labelled when first observed.
     """
-    text = instance.definition.paper_description
-    if text is not None:
-        return re.sub(r"\$([\w.]+?\.n\.\d+_\d+)", lambda m: _scope_phrase(instance, m.group(1)), text)
-    return describe_goal(instance.definition.goal, lambda s: _readable(instance.world, instance.scope[s], reserve=True))
+    instance.description_template = description_template(
+        instance.definition, instance.world, instance.scope, instance.descriptions)
+    return SCOPE_WORD.sub(lambda m: _scope_phrase(instance, m.group(1)), instance.description_template)
 
 
 def _scope_phrase(instance: TaskInstance, scope: str) -> str:
@@ -213,11 +225,6 @@ def _scope_phrase(instance: TaskInstance, scope: str) -> str:
     if scope in instance.scope:
         return _readable(instance.world, instance.scope[scope], reserve=True)
     return f"the {category_phrase(scope_synset(scope))}"
-
-
-def literal_text(literal: ParsedLiteral) -> str:
-    """A parsed bddl literal in BDDL form: ['not', ['open', 'x']] -> '(not (open x))'."""
-    return "(" + " ".join(literal_text(x) if isinstance(x, list) else x for x in literal) + ")"
 
 
 class _Builder:
@@ -255,6 +262,9 @@ class _Builder:
                 )
             ground = [s for s in scopes if _ground_class(scope_synset(s))]
             fixed = [s for s in scopes if s not in ground]
+            needed = {c for s in fixed for c in catalog.synset_categories(scope_synset(s))}
+            for room in rooms:
+                hang_listed_fixtures(self.world, room.id, needed)
             best_room, best = rooms[0].id, self._match_room(rooms[0].id, fixed)
             for room in rooms[1:]:
                 if len(best) == len(fixed):
@@ -377,8 +387,16 @@ class _Builder:
     def _on_support(self, name: str, support: str, relation: str, atom: ParsedLiteral) -> None:
         """Rest ``name`` at a free slot of ``support``, on the items already there when it is full;
         unlike a magic place action, never where another box already is (a full closed container
-        fails this scene)."""
-        if not self.world.place_if_room(name, support, relation, stack=True):
+        fails this scene). An item with no slot as it comes is turned a quarter and tried again when
+        its turned footprint lies within the surface (the slot grid follows the item's footprint:
+        a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
+        if self.world.place_if_room(name, support, relation, stack=True):
+            return
+        obj = self.world.objects[name]
+        lo, hi, _ = self.world.support_surface(self.world.objects[support], relation)
+        obj.size = obj.size[[1, 0, 2]]
+        if not (np.all(obj.size[:2] <= hi - lo) and self.world.place_if_room(name, support, relation, stack=True)):
+            obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 
     def _default_floor(self) -> str:

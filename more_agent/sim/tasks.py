@@ -99,6 +99,11 @@ def atoms(node: Any) -> Iterator[ParsedLiteral]:
         yield from atoms(child)
 
 
+def literal_text(literal: ParsedLiteral) -> str:
+    """A parsed bddl literal in BDDL form: ['not', ['open', 'x']] -> '(not (open x))'."""
+    return "(" + " ".join(literal_text(x) if isinstance(x, list) else x for x in literal) + ")"
+
+
 def atomic_predicates(parsed: list[ParsedLiteral]) -> set[str]:
     """Names of the atomic predicates used anywhere in a parse tree."""
     return {atom[0] for atom in atoms(parsed)}

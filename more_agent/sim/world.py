@@ -384,14 +384,13 @@ class World:
     ) -> np.ndarray | None:
         """Centre of the first slot on the support, in reading order, where the item's box (of ``size``,
         default its own) meets no other box (``_obstacles``); with ``stack``, when the surface is full,
-        on the next layer up (on the items already there; in a closed-lid container only while it fits
-        under the lid). An item wider than the surface overhangs it, centred. None when there is no such slot."""
+        at a slot flush with its far edges (``_slots``), else on the next layer up (on the highest item
+        in the way, whichever support it rests on; in a closed-lid container only while it fits under
+        the lid). An item wider than the surface overhangs it, centred. None when there is no such slot."""
         size = obj.size if size is None else size
         lo, hi, z = self.support_surface(support, relation)
         half = size[:2] / 2 + SLOT_GAP_M / 2
-        xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
-        gx, gy = np.meshgrid(xs, ys)  # rows follow y: reading order is row by row
-        slots = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        slots = _slots(lo, hi, half, flush=stack)
         while True:
             others = self._obstacles(obj, support, lo, hi, z, size[2])
             free = slots
@@ -402,7 +401,7 @@ class World:
                 free = slots[~overlap]
             if len(free):
                 return np.array([free[0, 0], free[0, 1], z + size[2] / 2])
-            layer = [o.top for o in others if o.parent == support.name and o.relation == relation]
+            layer = [o.top for o in others if o.kind == "item"]
             lidded = relation == "inside" and support.openable
             if not stack or not layer or (lidded and max(layer) + size[2] > support.top):
                 return None
@@ -424,6 +423,22 @@ class World:
         eps = 1e-5  # boxes that merely touch (a card under a barrel's band) do not overlap
         meets = np.all(centers - halves < hi3 - eps, axis=1) & np.all(centers + halves > lo3 + eps, axis=1)
         return [o for o, m in zip(objs, meets) if m]
+
+
+def _slots(lo: np.ndarray, hi: np.ndarray, half: np.ndarray, *, flush: bool) -> np.ndarray:
+    """(n, 2) slot centres on a surface from ``lo`` to ``hi`` for an item of half extents ``half``: a
+    grid from the near corner in reading order (rows follow y); with ``flush``, then the same grid
+    mirrored to each other corner, whose slots lie flush with the far edges where the first grid
+    leaves a strip narrower than the item (a lamp in one corner of a nightstand leaves the far end)."""
+    xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
+    grids = [(xs, ys)]
+    if flush:
+        fx, fy = lo[0] + hi[0] - xs[::-1], lo[1] + hi[1] - ys[::-1]
+        grids += [(fx, ys), (xs, fy), (fx, fy)]
+    out = []
+    for gx, gy in (np.meshgrid(a, b) for a, b in grids):
+        out.append(np.stack([gx.ravel(), gy.ravel()], axis=1))
+    return np.concatenate(out)
 
 
 def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:

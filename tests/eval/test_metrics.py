@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from more_agent.eval.metrics import (
@@ -57,10 +59,30 @@ def test_rtp_counts_the_conditions_that_include_an_observed_task_object() -> Non
     assert tp(r) == pytest.approx(2 / 4)
 
 
-def test_rtp_is_zero_when_nothing_observed_and_condition_without_objects_counts() -> None:
-    assert rtp(rec(conds=[(True, ["a"]), (True, ["b"])], observed=[])) == 0.0
-    assert rtp(rec(conds=[], observed=["a"])) == 0.0
+def test_rtp_is_none_when_nothing_observed_and_condition_without_objects_counts() -> None:
+    assert rtp(rec(conds=[(True, ["a"]), (True, ["b"])], observed=[])) is None
+    assert rtp(rec(conds=[], observed=["a"])) is None
     assert rtp(rec(conds=[(True, []), (False, ["x"])], observed=[])) == 1.0
+
+
+def test_an_episode_without_rtp_leaves_the_mean_instead_of_counting_zero() -> None:
+    """Why rTP came out below TP: an episode that saw none of its task objects counted rTP 0 while its
+    TP kept the conditions that hold without the robot (a fridge left closed: 'not open')."""
+    blind = rec(conds=[(True, ["fridge"]), (False, ["apple", "fridge"])], observed=[])
+    found = rec(conds=[(True, ["a", "shelf"]), (True, ["b", "shelf"]), (False, ["c", "shelf"])], observed=["a", "b"])
+    s = summarize([blind, found])
+    assert s.TP.mean == pytest.approx((1 / 2 + 2 / 3) / 2)
+    assert s.rTP is not None and (s.rTP.mean, s.rTP.n) == (pytest.approx(1.0), 1) and s.rTP.mean > s.TP.mean
+    assert summarize([blind]).rTP is None and summarize([blind]).TP.n == 1
+
+
+def test_records_of_older_versions_get_the_same_rtp_from_their_conditions() -> None:
+    """rTP is never stored: a record as version 2 wrote it is scored by the rule of today."""
+    old = rec(conds=[(True, ["a", "fridge"]), (False, ["b", "fridge"])], observed=["a"], llm="openai:gpt-4o")
+    data = old.model_dump(mode="json", exclude={"history"}) | {"schema_version": 2}
+    again = EpisodeRecord.model_validate_json(json.dumps(data))
+    assert rtp(again) == rtp(old) == 1.0 and again.history == "lasting"  # what version 2 showed an LLM planner
+    assert EpisodeRecord.model_validate({**data, "llm": None}).history == "paper"
 
 
 def test_wilson_interval_known_values() -> None:

@@ -61,6 +61,18 @@ def test_markdown_and_csv_have_a_row_per_system_and_task() -> None:
     assert float(rows[0]["SR"]) == 0.5 and float(rows[0]["SR_low"]) < 0.5 < float(rows[0]["SR_high"])
 
 
+def test_rtp_cells_say_n_when_episodes_have_none(tmp_path: Path) -> None:
+    blind = rec("t2").model_copy(update={"observed_objects": []})  # saw no task object: no rTP
+    records = [rec("t1"), blind]
+    md = summary_markdown(records)
+    assert "| more (openai:gpt-4o) | 2 | 2 | 0 | 0.0 [" in md and "100.0 [100.0, 100.0] (n=1) |" in md
+    assert "| more (openai:gpt-4o) | t2 | 1 | 0 | 0.0 [0.0, 79.3] | 100.0 [20.7, 100.0] | 100.0 [100.0, 100.0] | n/a |" in md
+    rows = {r["task"]: r for r in csv.DictReader(io.StringIO(summary_csv(records)))}
+    assert (rows["ALL"]["rTP"], rows["ALL"]["n_rTP"], rows["t2"]["rTP"], rows["t2"]["n_rTP"]) == ("1.000000", "1", "", "0")
+    html = render_report([SourcedRecord(blind, tmp_path)])
+    assert "rTP n/a" in html and "<td>n/a</td>" in html
+
+
 def test_html_escapes_all_record_text(tmp_path: Path) -> None:
     evil = rec(
         f"task{EVIL}",

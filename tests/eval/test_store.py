@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -95,6 +96,26 @@ def test_resume_without_run_json_checks_the_records(tmp_path: Path) -> None:
     with pytest.raises(UserError, match="planner: 'oracle' -> 'more'"):
         prepare_run_dir(run, config(planner="more"), resume=True)
     assert [r.task for r in prepare_run_dir(run, config(tasks=["a"]), resume=True)] == ["a"]
+
+
+def test_resume_must_keep_the_history_and_older_runs_ran_the_longer_one(tmp_path: Path) -> None:
+    llm = {"planner": "more", "llm": "openai:gpt-4o"}
+    run = tmp_path / "run"
+    prepare_run_dir(run, config(**llm, history="lasting"), resume=False)
+    with pytest.raises(UserError, match="history: 'lasting' -> 'paper'"):
+        prepare_run_dir(run, config(**llm), resume=True)
+    old = tmp_path / "old"  # run.json of a version before the option: its LLM planner showed the longer history
+    prepare_run_dir(old, config(**llm), resume=False)
+    data = json.loads((old / "run.json").read_text())
+    (old / "run.json").write_text(json.dumps({k: v for k, v in data.items() if k != "history"}))
+    assert read_run_config(old).history == "lasting"
+    with pytest.raises(UserError, match="history: 'lasting' -> 'paper'"):
+        prepare_run_dir(old, config(**llm), resume=True)
+    assert prepare_run_dir(old, config(**llm, history="lasting"), resume=True) == []
+    oracle = tmp_path / "oracle"  # no LLM: the history never mattered, the default is assumed
+    prepare_run_dir(oracle, config(), resume=False)
+    (oracle / "run.json").write_text(json.dumps(config().model_dump(exclude={"history"})))
+    assert prepare_run_dir(oracle, config(), resume=True) == []
 
 
 def test_run_folder_lock_refuses_a_second_writer_and_dies_with_its_holder(tmp_path: Path) -> None:

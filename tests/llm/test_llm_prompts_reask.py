@@ -20,7 +20,8 @@ from more_agent.llm import (
     render_prompt,
     room_messages,
 )
-from more_agent.llm.prompts import PROMPT_NAMES, prompt_fields
+from more_agent.errors import UserError
+from more_agent.llm.prompts import PROMPT_NAMES, check_history, prompt_fields
 from more_agent.skills import SKILLS
 from tests.fakes.openai_server import FakeOpenAIServer
 
@@ -59,12 +60,21 @@ def test_history_shows_last_five_and_all_failed() -> None:
     assert history_text([]) == "none"
 
 
-def test_history_keeps_every_lasting_success_and_names_its_objects() -> None:
+def test_paper_history_forgets_old_successes_and_lasting_keeps_them() -> None:
     placed = Action("go_to_and_place_inside", ["kitchen_0", "toolbox A"], ok=True, feedback="placed hammer A inside toolbox A")
     actions = [placed] + [Action("explore", ["kitchen_0"], ok=True, feedback="explored kitchen_0") for _ in range(7)]
-    lines = history_text(actions).splitlines()
+    paper = history_text(actions).splitlines()
+    assert paper == history_text(actions, "paper").splitlines()  # the paper's history is the default
+    assert [line.split(".")[0] for line in paper] == ["4", "5", "6", "7", "8"]
+    lines = history_text(actions, "lasting").splitlines()
     assert lines[0] == "1. go_to_and_place_inside(kitchen_0, toolbox A) -> succeeded: placed hammer A inside toolbox A"
     assert [line.split(".")[0] for line in lines] == ["1", "4", "5", "6", "7", "8"]  # explores: the last five only
+
+
+def test_history_modes_are_checked_with_the_closest_name() -> None:
+    assert check_history("lasting") == "lasting"
+    with pytest.raises(UserError, match=r"unknown history 'papr'; closest: paper; use --history with one of: paper, lasting"):
+        check_history("papr")
 
 
 def test_message_builders_fill_the_paper_fields() -> None:

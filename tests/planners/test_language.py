@@ -71,11 +71,12 @@ def test_filtered_scene_snapshot_keeps_supports_and_robot_room() -> None:
     kept = FilterResult(rooms={"living_room_0": ("door A",), "kitchen_0": ("apple A",)}, unknown_rooms=(), unknown_objects=())
     filtered = view.filtered(kept)
     _check_snapshot("scene_more_filtered", filtered.text())
-    assert [o.name for o in filtered.room("kitchen_0").objects] == ["floor", "apple A", "fridge A"]  # fridge: apple's container
+    # fridge: apple's container; book: in the robot's hand, never filtered away
+    assert [o.name for o in filtered.room("kitchen_0").objects] == ["floor", "apple A", "book A", "fridge A"]
     only_door = view.filtered(FilterResult(rooms={"living_room_0": ()}, unknown_rooms=(), unknown_objects=()),
                               always={view.robot_room})
     assert [r.name for r in only_door.rooms] == ["kitchen_0", "living_room_0"]
-    assert [o.name for o in only_door.room("kitchen_0").objects] == ["floor"]  # floors always stay
+    assert [o.name for o in only_door.room("kitchen_0").objects] == ["floor", "book A"]  # floors and the hand always stay
 
 
 def test_room_names_are_unique_and_stable() -> None:
@@ -94,8 +95,11 @@ def test_instance_ids_and_classes() -> None:
     assert set(moma.resolve("kitchen_0", "apple")) == {"apple A", "apple B"}
     assert moma.resolve("kitchen_0", "sofa") == ("sofa A",)  # wrong room: found anywhere
     assert more.resolve(None, "book A") == ("book A",) and more.resolve("kitchen_0", "unicorn A") == ()
-    assert "book A" in more.object_names() and "book A" not in more.text()  # held: not in any room
-    assert moma.names()["kitchen_0"] == ["floor", "apple", "cabinet", "fridge", "table"]
+    assert "book A" in more.object_names() and more.resolve("kitchen_0", "book A") == ("book A",)
+    assert "book A [held by the robot]" in more.text().splitlines()[0]  # held: in the robot's room
+    assert moma.names()["kitchen_0"] == ["floor", "apple", "book", "cabinet", "fridge", "table"]
+    robot_elsewhere = graph.model_copy(update={"robot": RobotNode(position=(6.0, 2.0), region_id="region_2")})
+    assert "book A [held by the robot]" in scene_view(robot_elsewhere, LanguageOptions()).room("living_room_0").text()
     assert more.resolve("kitchen_0", "floor") == ()  # floors are rooms' ground, not graph objects
 
 

@@ -117,3 +117,32 @@ def test_observed_items_are_reached_from_a_random_start() -> None:
     clearance ("no path on the map"); the item itself was within arm's reach of the robot's part of the map."""
     placements, _ = _shuffle(_world(0, start="random"), np.random.default_rng(100), check=False)
     assert placements >= 5
+
+
+TINY = Path(__file__).parents[1] / "fixtures" / "tiny_scene.json"
+
+
+def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_open() -> None:
+    """Grasping the paper bag carries the fruit in it: the text shows them in the bag in the robot's
+    room (not left behind, not an obstacle where the robot stands), and in the bag again where it is
+    put down. The door the robot opened stays in the text, open, even when no frame shows it."""
+    world = instantiate_in_scene("store_produce", load_scene(TINY), seed=0, distractors=False).world
+    body = Embodiment(world)
+    body.look_around()
+    bag = world.get("sack_1").label
+    fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))
+    _act(body, "open", "door_0")
+    _act(body, "grasp", "sack_1")
+    graph = body.build()
+    view = scene_view(graph, LanguageOptions())
+    robot_room = view.room(view.robot_room)
+    assert f"{bag} [held by the robot]" in robot_room.text()
+    assert all(_shown(view, f)[1] == ("inside", bag) and f in {o.name for o in robot_room.objects} for f in fruit), view.text()
+    cell = graph.occupancy.frame.cell_of(np.array([body.xy]))[0]
+    assert graph.occupancy.grid[cell[0], cell[1]] != 2, "what the robot carries maps as an obstacle where it stands"
+    _act(body, "place_ontop", "breakfast_table_0")
+    body.face((body.xy[0] - 5.0, body.xy[1]))  # look away from the door and the table
+    view = scene_view(body.build(), LanguageOptions())
+    assert _shown(view, bag)[1] == ("on top of", world.get("breakfast_table_0").label)
+    assert all(_shown(view, f)[1] == ("inside", bag) for f in fruit), view.text()
+    assert _shown(view, world.get("door_0").label)[0] == "open", view.text()

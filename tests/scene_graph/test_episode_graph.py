@@ -1,7 +1,7 @@
 """A whole episode's scene graph, built from rendered frames, matches the world's rooms.
 
-The robot visits every room of a generated BEHAVIOR-1K plan (Rs_int, all doors open) and turns
-once in place in each; the graph built from those frames must have one region per room, every
+The robot visits every room of a generated BEHAVIOR-1K plan (Rs_int, all doors open) and every
+door between them, and turns once in place at each; the graph built from those frames must have one region per room, every
 Voronoi node of a region inside that room, and every observed object in the region of its room.
 """
 
@@ -21,9 +21,10 @@ def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> Non
         world.set_open(door.id, True)
     grid = nav_grid(world)
     body = Embodiment(world)
-    for room in world.scene.rooms:
-        x0, y0, x1, y1 = room.bounds
-        world.set_robot_pose(*grid.centre(grid.snap((x0 + x1) / 2, (y0 + y1) / 2)), 0.0)
+    centres = [((r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2) for r in world.scene.rooms]
+    doors = [((d.bounds()[0] + d.bounds()[2]) / 2, (d.bounds()[1] + d.bounds()[3]) / 2) for d in world.scene.doors]
+    for x, y in centres + doors:  # as a robot driving from room to room sees them: the doors it passes too
+        world.set_robot_pose(*grid.centre(grid.snap(x, y)), 0.0)
         body.look_around()
     graph = body.build()
 

@@ -10,10 +10,10 @@ from bddl.condition_evaluation import compile_state
 
 from more_agent.errors import UserError
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
-from more_agent.sim.instantiate import InstantiationError, TaskInstance, instantiate, instantiate_in_scene, literal_text
+from more_agent.sim.instantiate import InstantiationError, TaskInstance, instantiate, instantiate_in_scene
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.scene import load_scene
-from more_agent.sim.tasks import task_set
+from more_agent.sim.tasks import literal_text, task_set
 
 KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
 

@@ -67,7 +67,9 @@ def test_camera_pose_is_a_pitched_opencv_frame():
     assert np.allclose(R[:, 2], [0, math.cos(math.radians(20)), -math.sin(math.radians(20))])  # forward: north, down
     assert np.allclose(R[:, 0], [1, 0, 0])  # right of north is east
     K = Camera().intrinsics()
-    assert K[0, 0] == pytest.approx(128.0) and K[0, 2] == pytest.approx(127.5)  # 90 deg horizontal FOV
+    # OmniGibson's camera: 17 mm focal length over a 20.955 mm aperture, 63.3 deg horizontal FOV
+    assert K[0, 0] == pytest.approx(128 * 17.0 / (20.955 / 2)) and K[0, 2] == pytest.approx(127.5)
+    assert math.degrees(2 * math.atan(128 / K[0, 0])) == pytest.approx(63.3, abs=0.05)
 
 
 def test_depth_to_a_wall_at_a_known_distance():
@@ -159,7 +161,7 @@ def test_items_rest_at_their_heights_and_held_items_vanish():
 
 def test_window_is_see_through_and_range_is_five_metres():
     world = two_rooms()
-    world.set_robot_pose(2.0, 1.0, -math.pi / 2)  # facing the window in the south wall
+    world.set_robot_pose(2.0, 1.6, -math.pi / 2)  # facing the window in the south wall
     frame = Renderer(Camera(pitch_deg=0.0)).render(world)
     v, u = pixel_of(frame, (2.0, 0.0, 1.5))
     assert np.isnan(frame.depth[v, u]) and frame.semantic[v, u] == 0 and not frame.rgb[v, u].any()

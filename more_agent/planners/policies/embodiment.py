@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from more_agent.mapping import MappingConfig
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
+from more_agent.sim.camera import Camera
 from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
 from more_agent.sim.motion import full_turn_angles
 from more_agent.sim.navgrid import DEFAULT_NAV, XY
@@ -45,9 +46,9 @@ class PolicyConfig(BaseModel):
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
     blind_radius_m: float = Field(
-        default=0.55, ge=0, description="Unknown cells this close to where the robot has been count as free on "
-        "its map: the camera (1.2 m high, pitched 20 degrees, 90 degree field of view) never sees the floor within "
-        "0.56 m of the robot."
+        default_factory=lambda: Camera().blind_floor_m, ge=0,
+        description="Unknown cells this close to where the robot has been count as free on its map: the camera "
+        "never sees the floor this close to the robot (``Camera.blind_floor_m``, 0.95 m for the Fetch's head camera).",
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
@@ -92,9 +93,10 @@ class Embodiment:
         """Render a frame from the current pose and fuse it into the scene-graph builder.
 
         The robot knows what it did: an item released since the last frame is reported as no longer
-        held, resting where it was put, even when no camera sees it (the builder keeps it at that box
-        until a frame shows it), and the objects in ``acted_on`` (world names: what it just opened or
-        closed) are reported with their new state even when out of view.
+        held, resting where it was put, even when no camera sees it (the builder keeps it, and what
+        rode on or in it, at their boxes until a frame shows them), and the objects in ``acted_on``
+        (world names: what it just opened or closed) are reported with their new state even when out
+        of view.
         """
         frame = self.renderer.render(self.world)
         if self.on_frame is not None:
@@ -113,7 +115,8 @@ class Embodiment:
                 held=self.world.robot.held == name, rests=self._rests(name),
             ))
         if released is not None:
-            self.builder.remember(self.world.get(released).instance_id, *self.world.get(released).box())
+            for obj in [self.world.get(released), *self.world.descendants(released)]:  # with what rode on it
+                self.builder.remember(obj.instance_id, *obj.box())
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())

@@ -33,13 +33,14 @@ def agent_nav_grid(
     """The traversable raster of the agent's map: seen-free cells, and unknown cells within
     ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
     ones, and the points in ``bumped_xy`` where a move was blocked by something the camera missed);
-    with ``retrace``, also the cells of ``stood_xy`` themselves (the robot's path) that are not obstacles."""
+    with ``retrace``, also the cells of ``stood_xy`` themselves (the robot's path, a polyline) that are not
+    obstacles."""
     grid = np.array(occupancy.grid)
     bumps = _cells(occupancy, bumped_xy)
     grid[bumps[:, 0], bumps[:, 1]] = OCCUPIED
     clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
     known_free = grid == FREE
-    path = _cells(occupancy, stood_xy)
+    path = _path_cells(occupancy, stood_xy)
     if len(path) and blind_radius_m > 0:
         seeds = np.ones(grid.shape, dtype=bool)
         seeds[path[:, 0], path[:, 1]] = False
@@ -54,7 +55,17 @@ def agent_nav_grid(
     )
 
 
-def _cells(occupancy: OccupancyMap, points: Sequence[XY]) -> np.ndarray:
+def _path_cells(occupancy: OccupancyMap, path: Sequence[XY]) -> np.ndarray:
+    """(n, 2) cells the polyline ``path`` passes through: a magic action's approach adds its waypoints
+    only, metres apart, and the robot stood on every cell between them too."""
+    points = np.asarray(path, dtype=float).reshape(-1, 2)
+    steps = np.diff(points, axis=0)
+    counts = np.ceil(np.abs(steps).max(axis=1) / occupancy.resolution_m).astype(int)
+    between = [points[i] + steps[i] * (np.arange(1, n)[:, None] / n) for i, n in enumerate(counts) if n > 1]
+    return _cells(occupancy, np.concatenate([points, *between]) if between else points)
+
+
+def _cells(occupancy: OccupancyMap, points: Sequence[XY] | np.ndarray) -> np.ndarray:
     """(n, 2) integer (ix, iy) cells of the points that lie on the occupancy grid."""
     if not len(points):
         return np.zeros((0, 2), dtype=int)
@@ -95,9 +106,14 @@ def path_to_nearest(grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: fl
 
 
 def object_goal(graph: SceneGraph, object_id: str) -> XY | None:
-    """The Voronoi node closest to an object (paper: navigate(room, object)); None on an empty graph."""
+    """The Voronoi node of the object's region closest to it (paper: navigate(room, object)): a wall
+    cabinet's nearest node may lie behind the wall, in the next room; any node when the object has no
+    region. None on an empty graph."""
     if len(graph.nav.node_xy) == 0:
         return None
-    x, y, _ = graph.objects[object_id].position
-    node = graph.closest_node((x, y))
-    return (float(graph.nav.node_xy[node][0]), float(graph.nav.node_xy[node][1]))
+    obj = graph.objects[object_id]
+    region = graph.regions.get(obj.region_id) if obj.region_id is not None else None
+    nodes = np.asarray(region.nav_nodes if region is not None and region.nav_nodes else range(len(graph.nav.node_xy)))
+    xy = np.asarray(graph.nav.node_xy)[nodes]
+    best = xy[int(np.argmin(np.hypot(xy[:, 0] - obj.position[0], xy[:, 1] - obj.position[1])))]
+    return (float(best[0]), float(best[1]))
