@@ -212,7 +212,7 @@ def test_a_disk_that_fills_up_during_run_viewer_leaves_no_empty_record(tmp_path:
                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     from more_agent import safe_files
 
-    real_write, budget = os.write, [400_000]
+    real_write, budget = os.write, [150_000]
 
     def filling(fd: int, data: bytes) -> int:
         budget[0] -= len(data)
