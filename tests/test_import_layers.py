@@ -11,7 +11,7 @@ import more_agent
 ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
-    ("__init__", "errors", "redaction", "interrupts", "records", "skills"),
+    ("__init__", "errors", "redaction", "interrupts", "records", "skills", "robot_spec", "vocabulary"),
     ("sim",),
     ("mapping",),
     ("scene_graph",),

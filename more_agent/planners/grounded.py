@@ -63,9 +63,7 @@ from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.clutter import is_surface
 from more_agent.sim.goals import Literal
 from more_agent.sim.navgrid import XY
-
-FLOOR = "floor"
-"""Object argument of a placement on the floor of a room."""
+from more_agent.vocabulary import FLOOR
 
 MAX_FAILURES = 2
 """An action is not tried again after failing this many times the same way."""

@@ -33,6 +33,7 @@ from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import REARRANGE_PREDICATES
 from more_agent.sim.world import World, WorldObject
 from more_agent.skills import skill_named
+from more_agent.vocabulary import RELATIONS
 
 ORACLE_PREDICATES = REARRANGE_PREDICATES
 """Goal predicates the oracle knows how to achieve: those of a rearrangement."""
@@ -98,7 +99,7 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     directly would undo the primary literal.
     """
     def placement(lit: Literal) -> bool:
-        return lit.predicate in ("inside", "ontop") and not lit.negated and lit.args[0] != ROBOT_NAME
+        return lit.predicate in RELATIONS and not lit.negated and lit.args[0] != ROBOT_NAME
 
     primary: dict[str, Literal] = {}
     for lit in literals:

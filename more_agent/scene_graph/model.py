@@ -23,6 +23,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSeriali
 from scipy.spatial import cKDTree
 
 from more_agent.sim.grid import Grid
+from more_agent import vocabulary
 
 SCHEMA_VERSION = 2
 
@@ -63,7 +64,7 @@ class InstanceInfo(_Model):
     category: str = Field(description="Object category, e.g. 'fridge', 'door', 'apple'.")
     open: bool | None = Field(default=None, description="Open state; None when not openable.")
     held: bool = Field(default=False, description="True while the robot holds it.")
-    rests: tuple[Literal["inside", "ontop"], str | None] | None = Field(
+    rests: tuple[vocabulary.Relation, str | None] | None = Field(
         default=None,
         description="How it rests as perceived: ('inside' | 'ontop', label of the container / support, None for "
         "the floor). None when not reported: the builder then derives relations from box geometry.",
@@ -105,7 +106,7 @@ class Relation(_Model):
     """A spatial relation derived from geometry: subject <predicate> object."""
 
     subject: str = Field(description="Object id of the contained / supported object.")
-    predicate: Literal["inside", "ontop"] = Field(description="Relation type.")
+    predicate: vocabulary.Relation = Field(description="Relation type.")
     object: str = Field(description="Object id of the container / support.")
 
 

@@ -24,12 +24,13 @@ from enum import Enum
 
 import numpy as np
 
+from more_agent.robot_spec import ROBOT
 from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
 from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
-REACH_M = 1.5
-"""Largest horizontal distance from the robot base to an object's footprint for a manipulation."""
+REACH_M = ROBOT.reach_m
+"""Largest horizontal distance from the robot base to an object's footprint for a manipulation (``RobotSpec.reach_m``)."""
 
 CLEARANCE_M = 0.45
 """Distance added to an object's half-diagonal for the navigation circle."""

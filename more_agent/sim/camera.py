@@ -6,10 +6,10 @@ camera coordinates to world coordinates. Pixel (u, v) has its centre at integer 
 ``K @ p_cam / p_cam[2]`` gives column / row indices directly and the principal point of a
 symmetric image is ((W - 1) / 2, (H - 1) / 2).
 
-Geometry (see docs/sensors.md for the reasons): 256 x 256 pixels, 90 degrees horizontal field of
-view with square pixels (so 90 degrees vertically too), mounted 1.2 m above the ground (the Fetch
-head camera with the torso lowered) and pitched 20 degrees down, 5 m range. With these values the
-ground is visible from 0.56 m in front of the robot and a 2.1 m door lintel from 1.9 m away.
+Geometry (see docs/sensors.md for the reasons) is the robot's, :attr:`more_agent.robot_spec.RobotSpec.camera`:
+256 x 256 pixels, 90 degrees horizontal field of view with square pixels (so 90 degrees vertically
+too), mounted 1.2 m above the ground (the Fetch head camera with the torso lowered) and pitched 20
+degrees down, 5 m range. The constants below name those values for this module's callers.
 """
 
 from __future__ import annotations
@@ -19,19 +19,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-IMAGE_SIZE = 256
+from more_agent.robot_spec import ROBOT
+
+IMAGE_SIZE = ROBOT.camera.image_size
 """Width and height of every frame in pixels (paper S.2)."""
 
-HFOV_DEG = 90.0
+HFOV_DEG = ROBOT.camera.hfov_deg
 """Horizontal field of view in degrees."""
 
-PITCH_DEG = 20.0
+PITCH_DEG = ROBOT.camera.pitch_deg
 """Fixed downward tilt of the optical axis below the horizon, in degrees."""
 
-HEAD_HEIGHT_M = 1.2
+HEAD_HEIGHT_M = ROBOT.camera.height_m
 """Height of the optical centre above the ground in metres."""
 
-MAX_RANGE_M = 5.0
+MAX_RANGE_M = ROBOT.camera.max_range_m
 """Sensor range: pixels whose z-depth exceeds it are invalid (paper S.2)."""
 
 

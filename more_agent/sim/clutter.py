@@ -29,7 +29,8 @@ import numpy as np
 
 from more_agent.sim import catalog
 from more_agent.sim.floorspots import free_floor_spot
-from more_agent.sim.world import Relation, World, WorldObject, floor_name
+from more_agent.sim.world import World, WorldObject, floor_name
+from more_agent.vocabulary import Relation
 
 MAX_PER_CATEGORY = 32
 """Most items of one category per room (a store lists 1,411 apples: a few full shelf rows stay)."""

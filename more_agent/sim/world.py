@@ -17,10 +17,9 @@ from typing import Literal
 
 import numpy as np
 
+from more_agent.robot_spec import ROBOT
 from more_agent.sim.scene import STRUCTURAL_CLASSES, Scene
-
-Relation = Literal["inside", "ontop"]
-ObjectKind = Literal["floor", "door", "furniture", "item"]
+from more_agent.vocabulary import ObjectKind, Relation
 
 SLAB_FRACTION = 0.08
 """Thickness of a container's bottom / top slab as a share of its height (inner items rest on it)."""
@@ -31,10 +30,10 @@ SLOT_GAP_M = 0.02
 CARRY_HEIGHT_M = 1.0
 """Height of a held item's centre, above the robot base."""
 
-REACH_TOP_M = 1.6
-"""Highest surface the arm places on (the Fetch arm with its torso lowered, like the 1.2 m camera, which
-sees items there from about a metre away). A support with inner levels whose top is higher takes
-items on top on its highest level at most this high (``support_surface``)."""
+REACH_TOP_M = ROBOT.reach_top_m
+"""Highest surface the arm places on (``RobotSpec.reach_top_m``: the Fetch arm with its torso lowered, like
+the 1.2 m camera, which sees items there from about a metre away). A support with inner levels whose top
+is higher takes items on top on its highest level at most this high (``support_surface``)."""
 
 LEVELLED_CATEGORIES = frozenset(
     """shelf bookcase grocery_shelf commercial_kitchen_shelf candy_dispenser_shelf dry_food_dispenser_shelf
