@@ -58,13 +58,10 @@ from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.records import ActionRecord, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.skills import SKILLS, SKILLS_BY_NAME
+from more_agent.skills import INVALID, SKILLS, SKILLS_BY_NAME
 from more_agent.vocabulary import FLOOR, ROOM_TYPES
 
 log = logging.getLogger(__name__)
-
-INVALID = "invalid"
-"""Name of the action recorded when the LLM gave no usable answer after the re-asks."""
 
 
 
@@ -235,7 +232,7 @@ class LLMPlanner:
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
+            return ActionResult(ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}")
         body, graph, view = self._body(), self._graph(), self._view()
         params = SKILLS_BY_NAME[action.name].params
         if not params:  # done
