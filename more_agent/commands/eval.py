@@ -73,8 +73,8 @@ def eval_(
         check_task_names(names)
         if scene is not None:
             get_scene(scene)  # an unknown scene fails with the closest names
-        for name in names if scene is not None else ():
-            check_scene_suits(name, scene)
+            for name in names:
+                check_scene_suits(name, scene)
         make_planner(planner, llm)  # an unknown planner or a missing LLM fails here, before any episode
     config = RunConfig(
         planner=planner,

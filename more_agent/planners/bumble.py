@@ -53,7 +53,14 @@ from more_agent.planners.llm_planner import filter_view, make_clients
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
-from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
+from more_agent.planners.visual_memory import (
+    MemoryConfig,
+    MemoryFrame,
+    VisualMemory,
+    covering_frames,
+    shows_points,
+    spread,
+)
 from more_agent.planners.vlm_prompts import (
     FrameAnswer,
     MarkAnswer,
@@ -69,11 +76,11 @@ from more_agent.planners.vlm_prompts import (
     step_messages,
 )
 from more_agent.records import ActionRecord, LLMUsage
-from more_agent.skills import INVALID
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame
+from more_agent.skills import INVALID
 
 log = logging.getLogger(__name__)
 

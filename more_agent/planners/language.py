@@ -200,6 +200,6 @@ def _merge(entries: Iterable[_Entry]) -> tuple[ObjectText, ...]:
     for name, oid, state, relation in entries:
         groups.setdefault((name, state or "", relation or ()), []).append(oid)
     return tuple(
-        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None)  # type: ignore[arg-type]
+        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None)
         for (n, s, r), ids in sorted(groups.items())
     )

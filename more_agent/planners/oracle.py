@@ -20,6 +20,7 @@ makes the oracle give up with a ``done`` whose ``gave_up`` says what failed and 
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Collection
 
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
@@ -86,7 +87,7 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     return out
 
 
-def choose_option(goals: GoalChecker, world: World, exclude: set[int] = frozenset()) -> int | None:
+def choose_option(goals: GoalChecker, world: World, exclude: Collection[int] = frozenset()) -> int | None:
     """The ground goal option (not in ``exclude``) with the fewest literals the oracle cannot achieve, then the fewest unmet."""
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)

@@ -28,9 +28,9 @@ from typing import Any
 
 from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
-from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.instantiate import TaskInstance
+from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import scope_synset
 from more_agent.vocabulary import FLOOR_SYNSETS
 

@@ -16,14 +16,14 @@ robot holds at most one object.
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Literal
+from typing import Annotated
 
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSerializer, PrivateAttr, model_validator
 from scipy.spatial import cKDTree
 
-from more_agent.sim.grid import Grid
 from more_agent import vocabulary
+from more_agent.sim.grid import Grid
 
 SCHEMA_VERSION = 2
 
@@ -31,17 +31,16 @@ Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
 
-def _array(dtype: type) -> object:
-    return Annotated[
-        np.ndarray,
-        BeforeValidator(lambda v: np.asarray(v, dtype=dtype)),
-        PlainSerializer(lambda a: a.tolist(), return_type=list),
-    ]
+def _as(dtype: type) -> BeforeValidator:
+    """Validation into a numpy array of ``dtype`` (JSON gives lists)."""
+    return BeforeValidator(lambda v: np.asarray(v, dtype=dtype))
 
 
-FloatArray = _array(np.float64)
-IntArray = _array(np.int64)
-BoolArray = _array(np.bool_)
+_AS_LIST = PlainSerializer(lambda a: a.tolist(), return_type=list)
+
+FloatArray = Annotated[np.ndarray, _as(np.float64), _AS_LIST]
+IntArray = Annotated[np.ndarray, _as(np.int64), _AS_LIST]
+BoolArray = Annotated[np.ndarray, _as(np.bool_), _AS_LIST]
 
 
 class Layer(str, Enum):

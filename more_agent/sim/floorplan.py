@@ -146,6 +146,12 @@ def scene_rng(name: str, seed: int) -> np.random.Generator:
     return np.random.default_rng([seed, zlib.crc32(name.encode())])
 
 
+def _rect(v: tuple[float, ...]) -> Rect:
+    """``v`` as a rectangle (x0, y0, x1, y1)."""
+    x0, y0, x1, y1 = v
+    return (x0, y0, x1, y1)
+
+
 def _round(v: tuple[float, ...], nd: int = 3) -> tuple[float, ...]:
     return tuple(round(float(x), nd) for x in v)
 
@@ -239,7 +245,7 @@ def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[s
         jitter = rng.uniform(0.85, 1.15, size=len(indoor))
         order = sorted(range(len(indoor)), key=lambda i: -areas[indoor[i]] * jitter[i])
         tiles = _squarify([areas[indoor[i]] for i in order], (0.0, 0.0, w, h))
-        rects = {indoor[i]: _round(t, 2) for i, t in zip(order, tiles)}
+        rects = {indoor[i]: _rect(_round(t, 2)) for i, t in zip(order, tiles)}
     long_sides, short_sides = (["S", "N"], ["E", "W"]) if w >= h else (["E", "W"], ["S", "N"])
     sides = [str(s) for s in rng.permutation(long_sides)] + [str(s) for s in rng.permutation(short_sides)]
     offset = dict.fromkeys(sides, 0.0)
@@ -250,8 +256,8 @@ def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[s
             length = areas[rid] ** 0.5
         depth = max(areas[rid] / length, 7.0)
         o = offset[side]
-        rects[rid] = _round({"S": (0, -o - depth, length, -o), "N": (0, h + o, length, h + o + depth),
-                             "W": (-o - depth, 0, -o, length), "E": (w + o, 0, w + o + depth, length)}[side], 2)
+        rects[rid] = _rect(_round({"S": (0, -o - depth, length, -o), "N": (0, h + o, length, h + o + depth),
+                             "W": (-o - depth, 0, -o, length), "E": (w + o, 0, w + o + depth, length)}[side], 2))
         offset[side] = o + depth
     return rects
 

@@ -367,10 +367,10 @@ class _Builder:
             if pred == "inside" and support.openable and atom[2] not in opened:
                 support.is_open = False
         elif pred == "under":
-            floor = floor_name(support.room)
+            floor = floor_name(support.room)  # type: ignore[arg-type]  # a support stands in a room
             self.world.place_on_floor_at(a, floor, (float(support.center[0]), float(support.center[1])))
         elif support.parent is None or self.world.objects[support.parent].kind == "floor" or support.kind != "item":
-            self._on_free_floor(a, floor_name(support.room), near=support)
+            self._on_free_floor(a, floor_name(support.room), near=support)  # type: ignore[arg-type]  # as above
         else:
             self._on_support(a, support.parent, support.relation or "ontop", atom)
 
@@ -378,7 +378,7 @@ class _Builder:
         """Rest ``name`` at a free slot of ``support``, on the items already there when it is full;
         unlike a magic place action, never where another box already is (a full closed container
         fails this scene)."""
-        if not self.world.place_if_room(name, support, relation, stack=True):
+        if not self.world.place_if_room(name, support, relation, stack=True):  # type: ignore[arg-type]  # ontop / inside
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 
     def _default_floor(self) -> str:

@@ -73,7 +73,7 @@ class NavGrid(Grid):
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.free.shape  # type: ignore[return-value]
+        return self.free.shape
 
     def cell_at(self, x: float, y: float) -> tuple[int, int]:
         """The (ix, iy) of the cell containing (x, y), clipped to the grid."""

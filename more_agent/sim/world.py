@@ -13,7 +13,6 @@ import re
 import string
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 

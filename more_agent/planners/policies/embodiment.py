@@ -29,7 +29,6 @@ from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
 from more_agent.vocabulary import Relation
 
-
 PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
 
