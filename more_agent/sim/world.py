@@ -160,8 +160,7 @@ class World:
         obj.instance_id = len(self.objects) + 1
         self.semantic_id(obj.category)
         self.objects[obj.name] = obj
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
         return obj
 
     def semantic_id(self, category: str) -> int:
@@ -275,8 +274,7 @@ class World:
         if not obj.openable:
             raise ValueError(f"{name} is not openable")
         obj.is_open = is_open
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
@@ -304,8 +302,7 @@ class World:
         self._move_subtree(obj, center)
         if self.robot.held == obj.name:
             self.robot.held = None
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def pick(self, name: str) -> None:
         """Put item ``name`` in the robot's gripper, detached from its support (no precondition checks)."""
@@ -313,15 +310,19 @@ class World:
         obj.parent, obj.relation = None, None
         self.robot.held = name
         self._carry()
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
+        self._changed(layout=self.robot.held is not None)  # a held item moved along
+
+    def _changed(self, *, layout: bool) -> None:
+        """The one place the versions move: ``version`` on every change, ``layout_version`` when an
+        object changed (pose, support, open state), not when the robot merely moved."""
         self.version += 1
-        if self.robot.held is not None:  # the held item moved along
+        if layout:
             self.layout_version += 1
 
     def _carry(self) -> None:
