@@ -48,7 +48,7 @@ class RobotSpec:
     """Largest horizontal distance from the base to an object's footprint for a manipulation."""
     reach_top_m: float = 1.6
     """Highest surface the arm places on; a support with inner levels whose top is higher takes items on
-    top on its highest level at most this high (``sim.world.support_surface``)."""
+    top on its highest level at most this high (``sim.packing.support_surface``)."""
     camera: CameraSpec = field(default_factory=CameraSpec)
 
 

@@ -7,7 +7,7 @@ from typing import get_args
 from more_agent.planners.policies.embodiment import PolicyConfig
 from more_agent.planners.room_types import room_type_counts
 from more_agent.robot_spec import ROBOT
-from more_agent.sim import actions, camera, world
+from more_agent.sim import actions, camera, packing
 from more_agent.sim.navgrid import DEFAULT_NAV
 from more_agent.vocabulary import RELATIONS, ROOM_TYPES, Relation, room_type
 
@@ -26,6 +26,6 @@ def test_relations_match_their_type() -> None:
 
 def test_simulator_and_planners_use_the_robot_spec() -> None:
     assert DEFAULT_NAV.robot_radius_m == ROBOT.radius_m
-    assert actions.REACH_M == ROBOT.reach_m and world.REACH_TOP_M == ROBOT.reach_top_m
+    assert actions.REACH_M == ROBOT.reach_m and packing.REACH_TOP_M == ROBOT.reach_top_m
     assert camera.Camera().hfov_deg == ROBOT.camera.hfov_deg and camera.IMAGE_SIZE == ROBOT.camera.image_size
     assert PolicyConfig().plan_inflation_m > ROBOT.radius_m

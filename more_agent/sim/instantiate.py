@@ -10,7 +10,7 @@ Steps (all deterministic for a given task, scene and seed):
    ('apple.n.01_1' -> 'apple_1').
 4. Placement literals run supports first (topological order): ``ontop``/``inside`` rest the item on
    / in its support (on a floor: at a free spot sampled against furniture, walls, doors and other
-   floor items; elsewhere at a free slot that no other box reaches into, ``sim.world.free_slot``:
+   floor items; elsewhere at a free slot that no other box reaches into, ``sim.packing.free_slot``:
    not inside a TV standing on the same table, on the highest level within reach of a tall shelf);
    ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
    ``touching`` on the floor beside the other object, or on the same support when that object is
