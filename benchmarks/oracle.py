@@ -41,7 +41,7 @@ def main() -> None:
             "task": task, "scene": record.scene, "instantiated": True, "success": record.success,
             "progress": round(record.task_progress, 3), "high_level_steps": record.high_level_steps,
             "low_level_steps": record.low_level_steps, "seconds": round(time.perf_counter() - t, 3),
-            "error": record.error,
+            "termination": record.termination, "gave_up": record.gave_up, "error": record.error,
         }), flush=True)
     print(json.dumps({
         "summary": True, "task_set": args.tasks, "seed": args.seed, "episodes": len(names),

@@ -30,10 +30,10 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE  # noqa: E402
 from more_agent.eval.report import SourcedRecord  # noqa: E402
 from more_agent.eval.report_writer import write_reports  # noqa: E402
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname  # noqa: E402
-from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE  # noqa: E402
 from more_agent.eval.viewer import run_episode_with_viewer, write_viewer  # noqa: E402
 from more_agent.llm import LLMConfig, make_client  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402

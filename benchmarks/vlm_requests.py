@@ -31,6 +31,8 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+from prompt_tokens import ScriptedLLM, pick_task  # noqa: E402  (benchmarks/ is on the path when run as a script)
+
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage  # noqa: E402
 from more_agent.llm.images import image_stats  # noqa: E402
 from more_agent.planners.base import EpisodeContext  # noqa: E402
@@ -38,7 +40,6 @@ from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner  # noqa: E4
 from more_agent.planners.visual_memory import VisualMemory  # noqa: E402
 from more_agent.sim.goals import GoalChecker  # noqa: E402
 from more_agent.sim.instantiate import instantiate  # noqa: E402
-from prompt_tokens import ScriptedLLM, pick_task  # noqa: E402  (benchmarks/ is on the path when run as a script)
 
 DEFAULT_SCENES = ("grocery_store_convenience", "house_single_floor")
 SKILLS = ("explore", "navigate", "explore", "go_to_and_open")

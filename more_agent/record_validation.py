@@ -18,7 +18,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from more_agent.errors import UserError
-from more_agent.records import RECORD_SCHEMA_VERSION, EpisodeRecord, upgrade_from_2
+from more_agent.records import RECORD_SCHEMA_VERSION, UPGRADES, EpisodeRecord
 from more_agent.redaction import redact_tree
 
 MAX_COUNT = 10**12
@@ -27,7 +27,7 @@ MAX_COUNT = 10**12
 MAX_COST_USD = 1e9
 """Largest cost a record may hold."""
 
-MIGRATIONS: dict[int, Callable[[dict[str, Any]], dict[str, Any]]] = {2: upgrade_from_2}
+MIGRATIONS: dict[int, Callable[[dict[str, Any]], dict[str, Any]]] = UPGRADES
 """Older schema version -> function that turns such a record into the next version's form. A version
 missing here is refused with a message (no migration for schema 1 exists: its records predate this
 repository's first release)."""

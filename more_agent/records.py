@@ -2,17 +2,57 @@
 
 Written as ``DIR/episode.json`` by ``more-agent run`` and as one line of ``DIR/episodes.jsonl`` by
 ``more-agent eval``. Metrics (``more_agent.eval.metrics``) are pure functions of these records.
+
+Everything that says why something ended is typed: an action's :class:`FailureReason` (the world's and
+the subpolicies' reason, carried as is from the env to the record), the episode's
+:data:`Termination` and, for a system error only, its :data:`ErrorKind`. Nothing downstream parses
+feedback or error text. Records of older schema versions are read by upgrading them
+(:meth:`EpisodeRecord._upgrade`).
 """
 
 from __future__ import annotations
 
+from enum import Enum
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-RECORD_SCHEMA_VERSION = 3
-"""3: ``history`` (the action history option) and ``descriptions`` (the description mode); records of
-version 2 read as :data:`LEGACY_HISTORY` for LLM planners and :data:`LEGACY_DESCRIPTIONS`."""
+RECORD_SCHEMA_VERSION = 4
+"""4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
+only); 3: ``history`` (the action history option) and ``descriptions`` (the description mode). Older
+records are read through :data:`UPGRADES`."""
+
+
+class FailureReason(str, Enum):
+    """Why an action failed: the world's magic actions, the subpolicies and the planners report one."""
+
+    UNKNOWN_OBJECT = "unknown_object"
+    HIDDEN = "hidden"
+    NOT_REACHABLE = "not_reachable"
+    PATH_BLOCKED_BY_DOOR = "path_blocked_by_door"
+    TOO_FAR = "too_far"
+    HAND_FULL = "hand_full"
+    HAND_EMPTY = "hand_empty"
+    NOT_OPENABLE = "not_openable"
+    ALREADY_OPEN = "already_open"
+    ALREADY_CLOSED = "already_closed"
+    NOT_GRASPABLE = "not_graspable"
+    TARGET_CLOSED = "target_closed"
+    INVALID_TARGET = "invalid_target"
+    INVALID_ANSWER = "invalid_answer"
+    """The planner's model gave no usable answer (after its re-asks): no skill ran."""
+
+
+REACH_FAILURES = frozenset({FailureReason.NOT_REACHABLE, FailureReason.PATH_BLOCKED_BY_DOOR})
+"""Reasons of an action that failed on the way to its target (no path, blocked), not at it."""
+
+Termination = Literal["done", "step_limit", "steps_after_goal"]
+"""How the episode loop ended (paper Sec. III-D): the planner called done(), the high-level step limit
+passed, or the planner kept acting for too many steps after every goal condition held."""
+
+ErrorKind = Literal["llm", "input", "crash"]
+"""What kind of system error ended an episode: the LLM failed (transport, server, replay miss), the
+input was bad (unknown task or scene, a task that cannot be instantiated), or code raised / a worker died."""
 
 FailureCause = Literal[
     "never_observed",
@@ -51,6 +91,33 @@ def upgrade_from_2(data: dict[str, Any]) -> dict[str, Any]:
     return {"descriptions": LEGACY_DESCRIPTIONS, **data, "schema_version": 3}
 
 
+def upgrade_from_3(data: dict[str, Any]) -> dict[str, Any]:
+    """A record of schema 3 (or 2) in schema 4's form. Those kept the step limit, the steps-after-goal end
+    and a planner's giving up in ``error`` as text, the one place text is read: the phrases the runner
+    of those versions wrote. Their actions carry no reasons."""
+    data = {**data, "schema_version": 4}
+    error: str | None = data.get("error")
+    if data.get("done_called"):
+        data["termination"] = "done"
+    if error is None:
+        return data
+    if error.startswith("step limit of "):
+        data.update(termination="step_limit", error=None)
+    elif error.startswith("acted for more than "):
+        data.update(termination="steps_after_goal", error=None)
+    elif data.get("done_called") and data.get("traceback") is None:
+        data.update(gave_up=error, error=None)
+    else:
+        crashed = data.get("traceback") or data.get("retryable")
+        data["error_kind"] = "llm" if error.startswith("LLM error") else "crash" if crashed else "input"
+    return data
+
+
+UPGRADES = {2: upgrade_from_2, 3: upgrade_from_3}
+"""Schema version -> the function that turns such a record into the next version's form. Schema 1
+predates the first release: no step exists, and validation refuses it (``record_validation``)."""
+
+
 def legacy_history(data: dict[str, Any]) -> dict[str, Any]:
     """Stored ``data`` (a record or run configuration) written before the history option, with the
     ``history`` its episodes ran with: the longer one for an LLM planner, else the default."""
@@ -78,6 +145,7 @@ class ActionRecord(FrozenModel):
     name: str = Field(description="Subpolicy or action name, e.g. 'go_to_and_grasp'.")
     arguments: list[str] = Field(default_factory=list, description="Arguments as given.")
     ok: bool = Field(description="Whether the action succeeded.")
+    reason: FailureReason | None = Field(default=None, description="Why it failed (None on success, or when no reason applies).")
     feedback: str = Field(default="", description="Feedback returned to the planner (failure reason if not ok).")
     low_level_steps: int = Field(default=0, description="Low-level steps (moves, turns) the action took.")
 
@@ -160,7 +228,14 @@ class EpisodeRecord(BaseModel):
     timings: dict[str, float] = Field(default_factory=dict, description="Seconds per phase, e.g. 'instantiate'.")
     world_stats: WorldStats | None = Field(default=None, description="Size and difficulty of the world; None if not built.")
     failure: Failure | None = Field(default=None, description="Why the episode failed; None for a success.")
-    error: str | None = Field(default=None, description="None, or why the episode ended abnormally.")
+    termination: Termination | None = Field(
+        default=None, description="How the step loop ended; None when it did not end on its own (a system error)."
+    )
+    gave_up: str | None = Field(
+        default=None, description="The planner's reason when it called done() on purpose with goals unmet."
+    )
+    error: str | None = Field(default=None, description="None, or the system error that ended the episode abnormally.")
+    error_kind: ErrorKind | None = Field(default=None, description="The kind of ``error``; None without one.")
     retryable: bool = Field(
         default=False, description="The error is transient (LLM transport, worker death, timeout): worth re-running."
     )
@@ -168,10 +243,15 @@ class EpisodeRecord(BaseModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _before_history_option(cls, data: Any) -> Any:
-        """A stored record of schema version 2 says which history and descriptions its episode ran with."""
-        if isinstance(data, dict) and data.get("schema_version", RECORD_SCHEMA_VERSION) == 2:
-            return upgrade_from_2(data)
+    def _upgrade(cls, data: Any) -> Any:
+        """A stored record of an older schema version in today's form (:data:`UPGRADES`, step by step);
+        versions it has no step for are left to the validation that refuses them."""
+        if not isinstance(data, dict):
+            return data
+        version = data.get("schema_version", RECORD_SCHEMA_VERSION)
+        while isinstance(version, int) and version in UPGRADES:
+            data, version = UPGRADES[version](data), version + 1
+        return data
         return data
 
     def key(self) -> tuple[str, str, int, str]:

@@ -73,6 +73,10 @@ SKILLS: tuple[Skill, ...] = (
 
 SKILLS_BY_NAME: dict[str, Skill] = {s.name: s for s in SKILLS}
 
+INVALID = "invalid"
+"""Not a skill: the action name planners record when their model gave no usable answer after the re-asks
+(its reason is ``FailureReason.INVALID_ANSWER``)."""
+
 MANIPULATION_VERBS: tuple[str, ...] = tuple(s.world_action for s in SKILLS if s.changes_world and s.world_action)
 """The world actions of the go-to-and-act skills: open, close, grasp, place_inside, place_ontop."""
 

@@ -11,7 +11,8 @@ import more_agent
 ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
-    ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills"),
+    ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills",
+     "robot_spec", "vocabulary"),
     ("sim",),
     ("mapping",),
     ("scene_graph",),

@@ -16,8 +16,8 @@ from more_agent.commands._common import (
     DistractorsOption,
     HistoryOption,
     StartOption,
-    err_console,
     episodes_exit_status,
+    err_console,
     user_errors_exit_2,
 )
 from more_agent.errors import UserError
@@ -73,8 +73,8 @@ def eval_(
     from more_agent.eval.report_writer import write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
-    from more_agent.sim.descriptions import check_description_mode
     from more_agent.llm.prompts import check_history
+    from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits
 
@@ -98,8 +98,8 @@ def eval_(
         check_task_names(names)
         if scene is not None:
             get_scene(scene)  # an unknown scene fails with the closest names
-        for name in names if scene is not None else ():
-            check_scene_suits(name, scene)
+            for name in names:
+                check_scene_suits(name, scene)
         make_planner(planner, llm)  # an unknown planner or a missing LLM fails here, before any episode
     config = RunConfig(
         planner=planner,

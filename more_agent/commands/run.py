@@ -74,6 +74,7 @@ def open_bag_recorder(path: Path, storage: str) -> BagRecorder:
 def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     """A short summary of an episode for the terminal (record text shown as plain text, never markup)."""
     from more_agent.eval.episode_folder import EPISODE_FILE, MAP_FILE, VIEWER_FILE
+    from more_agent.eval.termination import describe
 
     table = Table(show_header=False, box=None, pad_edge=False)
     table.add_column(style="bold")
@@ -85,8 +86,9 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     table.add_row("progress", f"{record.task_progress:.2f} ({met}/{len(record.goal_conditions)} goal conditions)")
     table.add_row("steps", f"{record.high_level_steps} high-level, {record.low_level_steps} low-level")
     table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
-    if record.error:
-        table.add_row("why", Text(for_terminal(record.error)))  # may quote a server: never markup nor escapes
+    why = record.error or record.gave_up or (describe(record.termination) if record.termination and not record.success else "")
+    if why:
+        table.add_row("why", Text(for_terminal(why)))  # may quote a server: never markup nor escapes
     names = (EPISODE_FILE, MAP_FILE, VIEWER_FILE)
     files = [out_dir / name for name in names if (out_dir / name).is_file()]
     table.add_row("files", Text(for_terminal(", ".join(map(str, files))) or "none"))

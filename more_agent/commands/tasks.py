@@ -44,7 +44,14 @@ def show(
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
     from more_agent.sim.instantiate import instantiate
-    from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, literal_text, load_task, suitable_scenes
+    from more_agent.sim.tasks import (
+        EXCLUDED_SCENES,
+        check_scene_suits,
+        draw_scenes,
+        literal_text,
+        load_task,
+        suitable_scenes,
+    )
 
     definition = load_task(task)
     scenes = suitable_scenes(task)

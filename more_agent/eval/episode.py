@@ -1,10 +1,11 @@
 """The episode runner: instantiate a task, drive a planner step by step, check the goal, write the record.
 
-``run_episode(spec)`` never raises for a failing episode: the reason goes into ``record.error`` (and
-``record.traceback`` when code raised; an LLM error is recorded without one). Every planner, the
-oracle and the LLM planners alike, runs through this one loop. Termination follows the paper
-(Sec. III-D): the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the planner keeps acting for
-more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. The step's motion (low-level
+``run_episode(spec)`` never raises for a failing episode: a system error goes into ``record.error`` with
+its ``error_kind`` (and ``record.traceback`` when code raised; an LLM error is recorded without one).
+Every planner, the oracle and the LLM planners alike, runs through this one loop. Termination follows
+the paper (Sec. III-D, :mod:`more_agent.eval.termination`) and is recorded typed in
+``record.termination``: the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the
+planner keeps acting for more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. The step's motion (low-level
 steps and path) is read from the planner's robot, the same way for every planner. With ``out_dir``
 an :class:`~more_agent.eval.episode_folder.EpisodeFolder` writes the episode's files: the record,
 the map, each step's timeline line and the planner's step trace. Timings are seconds per phase:
@@ -24,6 +25,7 @@ from typing import TYPE_CHECKING
 from more_agent.errors import UserError
 from more_agent.eval.episode_folder import EpisodeFolder
 from more_agent.eval.failure import classify_failure
+from more_agent.eval.termination import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
@@ -37,14 +39,9 @@ if TYPE_CHECKING:
     from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
 
-MAX_HIGH_LEVEL_STEPS = 50
-"""An episode ends after this many high-level steps (paper Sec. III-D)."""
-
-STEPS_AFTER_GOAL = 5
-"""An episode ends when the planner acts more than this many steps after all goal conditions hold without done()."""
-
 LLM_ERROR_PREFIX = "LLM error"
-"""Start of ``record.error`` when the LLM failed (transport, server, replay miss): the episode ended abnormally."""
+"""Start of ``record.error`` when the LLM failed (transport, server, replay miss), for people to read
+(``record.error_kind`` says it for code)."""
 
 
 def observed_task_objects(scope: dict[str, str], world_names: Iterable[str]) -> list[str]:
@@ -140,14 +137,14 @@ def run_episode(
             folder.start(steps_log=planner.llm is not None)
         _run_steps(record, planner, goals, world, clock, folder)
     except LLMError as e:
-        record.error = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}"
+        record.error, record.error_kind = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}", "llm"
         record.retryable = e.retryable
     except UserError as e:
         if strict:
             raise
-        record.error = redact(str(e))
+        record.error, record.error_kind = redact(str(e)), "input"
     except Exception as e:  # noqa: BLE001 - an episode that raises is a recorded failure
-        record.error = redact(f"{type(e).__name__}: {e}")
+        record.error, record.error_kind = redact(f"{type(e).__name__}: {e}"), "crash"
         record.traceback = redact(traceback.format_exc())
         record.retryable = isinstance(e, OSError) and e.errno in DISK_FULL_ERRNOS  # free space, run again
     if world is not None and goals is not None and planner is not None:
@@ -185,7 +182,7 @@ def world_stats(instance: TaskInstance) -> WorldStats:
 
 def ended_abnormally(record: EpisodeRecord) -> bool:
     """Whether the episode ended in an error of the system (code raised, the LLM failed), not of the agent."""
-    return record.traceback is not None or record.retryable or (record.error or "").startswith(LLM_ERROR_PREFIX)
+    return record.traceback is not None or record.retryable or record.error_kind == "llm"
 
 
 def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
@@ -219,7 +216,7 @@ def _run_steps(
         clock.add("act", t)
         record.actions.append(ActionRecord(
             step=record.high_level_steps, name=action.name, arguments=list(action.arguments), ok=result.ok,
-            feedback=clip(result.feedback, MAX_FEEDBACK_CHARS), low_level_steps=result.low_level_steps,
+            reason=result.reason, feedback=clip(result.feedback, MAX_FEEDBACK_CHARS), low_level_steps=result.low_level_steps,
         ))
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps
@@ -228,17 +225,17 @@ def _run_steps(
             targets = [world.display_label(a) if a in world.objects else a for a in action.arguments]
             folder.write_step(record, status, targets, planner.step_trace())
         if action.is_done:
-            record.done_called = True
+            record.done_called, record.termination = True, "done"
             if not status.all_met and action.gave_up:
-                record.error = action.gave_up
+                record.gave_up = action.gave_up
             return
         # Steps taken while every goal condition already held (the completing step is not one of them).
         steps_since_goal = steps_since_goal + 1 if goal_held and status.all_met else 0
         goal_held = status.all_met
         if steps_since_goal > STEPS_AFTER_GOAL:
-            record.error = f"acted for more than {STEPS_AFTER_GOAL} steps after all goal conditions held, without done()"
+            record.termination = "steps_after_goal"
             return
-    record.error = f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
+    record.termination = "step_limit"
 
 
 def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], planner: Planner) -> None:

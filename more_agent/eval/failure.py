@@ -4,6 +4,8 @@
 actions and feedback, error, goal conditions, observed task objects) and the final world. Causes
 are checked in the order of :data:`CAUSE_ORDER`; the first that applies wins (docs/evaluation.md
 defines each). Counts per cause and system are pure functions of records (:func:`cause_counts`).
+Everything it reads is typed: the actions' :class:`~more_agent.records.FailureReason`, the episode's
+termination and error kind; no feedback or error text is parsed.
 """
 
 from __future__ import annotations
@@ -11,7 +13,8 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterable, Sequence
 
-from more_agent.records import ActionRecord, EpisodeRecord, Failure, FailureCause
+from more_agent.eval.termination import describe
+from more_agent.records import REACH_FAILURES, ActionRecord, EpisodeRecord, Failure, FailureCause, FailureReason
 from more_agent.sim.world import World
 from more_agent.skills import SKILLS
 
@@ -19,13 +22,8 @@ CAUSE_ORDER: tuple[FailureCause, ...] = (
     "llm_error", "other", "done_not_called", "wrong_instance", "never_observed", "invalid_llm_answers",
     "unreachable", "subpolicy_failure", "done_early", "step_limit",
 )
-"""Causes in the order they are tested; 'other' here means the episode raised (its traceback is kept)."""
-
-UNREACHABLE_FEEDBACK = ("cannot reach", "no path on the map", "the way is blocked", "blocked by closed door")
-"""Feedback fragments of a failed approach (rather than a failed manipulation)."""
-
-INVALID_ACTION = "invalid"
-"""Action name the LLM planners record for an answer still invalid after the re-asks."""
+"""Causes in the order they are tested; 'other' here means a system error other than the LLM's (code raised,
+bad input: ``record.error``) or an episode that never ran."""
 
 INVALID_SHARE = 0.5
 """An episode whose share of invalid actions reaches this failed on the LLM's answers."""
@@ -36,19 +34,20 @@ MANIPULATING = frozenset(s.name for s in SKILLS if s.changes_world)
 
 def is_reach_failure(action: ActionRecord) -> bool:
     """Whether a failed action failed on the way to its target (no path, blocked), not at it."""
-    return not action.ok and any(f in action.feedback for f in UNREACHABLE_FEEDBACK)
+    return not action.ok and action.reason in REACH_FAILURES
 
 
 def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | None:
     """The failure of a finished episode (None for a success); see the module docstring."""
     if record.success:
         return None
-    if record.error and record.error.startswith("LLM error"):
-        return Failure(cause="llm_error", detail=record.error)
-    if record.traceback is not None or world is None:
+    if record.error_kind == "llm":
+        return Failure(cause="llm_error", detail=record.error or "")
+    if record.error is not None or world is None:
         return Failure(cause="other", detail=record.error or "the episode did not run")
+    ended = describe(record.termination) if record.termination not in (None, "done") else ""
     if record.all_goals_met:
-        return Failure(cause="done_not_called", detail=record.error or "every goal condition held; done() never called")
+        return Failure(cause="done_not_called", detail=ended or "every goal condition held; done() never called")
     unmet = [c for c in record.goal_conditions if not c.satisfied]
     needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     labels = {o: world.get(o).label or o for o in needed}
@@ -59,7 +58,7 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     unseen = [o for o in needed if o not in set(record.observed_objects)]
     if unseen:
         return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
-    invalid = sum(a.name == INVALID_ACTION for a in record.actions)
+    invalid = sum(a.reason is FailureReason.INVALID_ANSWER for a in record.actions)
     if record.actions and invalid / len(record.actions) >= INVALID_SHARE:
         return Failure(cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers")
     refs = {ref for o in needed for ref in (o, labels[o])}  # the oracle names world objects, the others labels
@@ -72,8 +71,8 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
         return Failure(cause="subpolicy_failure", detail=f"{last.name}({', '.join(last.arguments)}): {last.feedback}")
     first_unmet = unmet[0].text if unmet else ""
     if record.done_called:
-        return Failure(cause="done_early", detail=record.error or f"done() with {first_unmet} unmet")
-    return Failure(cause="step_limit", detail=f"{record.error or 'step limit'}; {first_unmet} unmet")
+        return Failure(cause="done_early", detail=record.gave_up or f"done() with {first_unmet} unmet")
+    return Failure(cause="step_limit", detail=f"{ended or 'step limit'}; {first_unmet} unmet")
 
 
 def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World) -> str:

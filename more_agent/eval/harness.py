@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
+from typing import Any
 
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
@@ -336,7 +337,7 @@ def _run_pending(
         successes, errors = sum(r.success for r in records), sum(r.error is not None for r in records)
         done = len(records)
 
-        def fields() -> dict[str, str]:
+        def fields() -> dict[str, Any]:
             return {"sr": f"{successes / done:.1%}" if done else "-", "errors": str(errors)}
 
         bar_id = bar.add_task(config.planner, total=len(todo), **fields())

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import csv
 import io
-from html import escape
 from collections.abc import Sequence
+from html import escape
 from pathlib import Path
 from typing import NamedTuple
 

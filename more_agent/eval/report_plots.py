@@ -11,7 +11,6 @@ Every function takes plain records and writes one file; systems are ordered as i
 from __future__ import annotations
 
 import io
-import re
 from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
@@ -113,17 +112,15 @@ def plot_distributions(records: Sequence[EpisodeRecord], path: Path) -> Path:
 
 
 def failure_reason(record: EpisodeRecord) -> str | None:
-    """Why an unsuccessful episode failed: its ``failure.cause`` when classified, else the head of its
-    ``error`` (up to the first ':' or '('), else 'unclassified'; None for a success."""
+    """Why an unsuccessful episode failed: its ``failure.cause`` when classified, else the kind of its
+    system error ('llm error'), else how it ended ('step_limit'), else 'unclassified'; None for a success."""
     if record.success:
         return None
     if record.failure is not None:
         return record.failure.cause
-    if record.error:
-        head = re.split(r"[:(]", record.error, maxsplit=1)[0].strip()
-        head = re.sub(r"\d+", "N", head)  # 'step limit of 50 ...' and '... of 30 ...' are one reason
-        return head[:48] or "error"
-    return "unclassified"
+    if record.error is not None:
+        return f"{record.error_kind or 'system'} error"
+    return record.termination or "unclassified"
 
 
 def plot_failures(records: Sequence[EpisodeRecord], path: Path) -> Path:

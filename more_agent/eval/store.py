@@ -19,10 +19,17 @@ from types import TracebackType
 from pydantic import BaseModel, Field, ValidationError
 
 from more_agent.errors import UserError, check_writable_dir
-from more_agent.redaction import redact_tree
 from more_agent.eval.runlock import LOCK_FILE
 from more_agent.record_validation import BadRecord, parse_record, record_json
-from more_agent.records import DEFAULT_HISTORY, LEGACY_DESCRIPTIONS, EpisodeRecord, EpisodeSpec, HistoryMode, legacy_history
+from more_agent.records import (
+    DEFAULT_HISTORY,
+    LEGACY_DESCRIPTIONS,
+    EpisodeRecord,
+    EpisodeSpec,
+    HistoryMode,
+    legacy_history,
+)
+from more_agent.redaction import redact_tree
 from more_agent.safe_files import open_nofollow, read_bounded, write_atomic
 
 EPISODES_FILE = "episodes.jsonl"

@@ -37,7 +37,7 @@ def error_record(spec: EpisodeSpec, error: str, tb: str | None = None, *, retrya
     ``retryable`` marks a transient cause (worker death, LLM transport) that ``--retry-errors`` re-runs.
     """
     return EpisodeRecord.for_spec(
-        spec, error=redact(error), traceback=redact(tb) if tb else None, retryable=retryable
+        spec, error=redact(error), error_kind="crash", traceback=redact(tb) if tb else None, retryable=retryable
     )
 
 

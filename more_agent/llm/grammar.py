@@ -35,7 +35,7 @@ def bounded_schema(schema: Any, field: str = "") -> Any:
         return [bounded_schema(item, field) for item in schema]
     if not isinstance(schema, dict):
         return schema
-    out = {}
+    out: dict[str, Any] = {}
     for key, value in schema.items():
         if key == "properties" and isinstance(value, dict):
             out[key] = {name: bounded_schema(sub, name) for name, sub in value.items()}

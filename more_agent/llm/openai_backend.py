@@ -20,9 +20,6 @@ from typing import TYPE_CHECKING, Any
 from more_agent.llm import constants as C
 from more_agent.llm.client import ChatRequest, Generation
 from more_agent.llm.config import LLMConfig, StructuredOutput
-from more_agent.llm.limits import MAX_ERROR_CHARS, clip
-from more_agent.llm.usage import token_count
-from more_agent.redaction import has_credentials, redact, register_secret
 from more_agent.llm.errors import (
     LLMAuthError,
     LLMBadRequest,
@@ -36,6 +33,9 @@ from more_agent.llm.errors import (
     MissingAPIKey,
 )
 from more_agent.llm.grammar import bounded_schema
+from more_agent.llm.limits import MAX_ERROR_CHARS, clip
+from more_agent.llm.usage import token_count
+from more_agent.redaction import has_credentials, redact, register_secret
 
 if TYPE_CHECKING:
     import openai
@@ -223,7 +223,7 @@ class OpenAIBackend:
             except _SchemaRejected as rejected:
                 e = rejected.error
                 if self.structured_output is StructuredOutput.AUTO:
-                    later = SCHEMA_FORMATS[SCHEMA_FORMATS.index(schema_format) + 1:]  # type: ignore[arg-type]
+                    later = SCHEMA_FORMATS[SCHEMA_FORMATS.index(schema_format) + 1:]
                     self.schema_format = later[0] if later else None
                     log.warning("%s rejected response_format %s (%s); now %s", self.base_url, schema_format,
                                 clip(str(e), MAX_ERROR_CHARS),

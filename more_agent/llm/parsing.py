@@ -91,9 +91,9 @@ def _skill_and_args(answer: Answer, skill_names: Collection[str]) -> tuple[str, 
         args = _split_args(args)
     if not isinstance(args, list) or not all(isinstance(a, str) for a in args):
         raise InvalidAnswer('"arguments" must be a list of room/object names (strings)')
-    call = _CALL.fullmatch(skill.strip())
-    if call is not None and not args:
-        return call.group(1), _split_args(call.group(2)), reasoning
+    written = _CALL.fullmatch(skill.strip())
+    if written is not None and not args:
+        return written.group(1), _split_args(written.group(2)), reasoning
     return skill.strip().removesuffix("()"), [a.strip() for a in args], reasoning
 
 
@@ -171,9 +171,9 @@ def parse_filter_answer(answer: Answer, scene: Mapping[str, Collection[str]]) ->
     if obj is None:
         raise InvalidAnswer('no JSON object found; answer with {"rooms": [{"room": ..., "objects": [...]}]}')
     home: dict[str, list[str]] = {}
-    for room, objects in scene.items():
+    for name, objects in scene.items():
         for o in objects:
-            home.setdefault(o, []).append(room)
+            home.setdefault(o, []).append(name)
     kept: dict[str, list[str]] = {}
     unknown_rooms: list[str] = []
     unknown_objects: list[str] = []

@@ -63,10 +63,14 @@ def render_prompt(name: str, **fields: str) -> list[ChatMessage]:
 class HistoryItem(Protocol):
     """An executed action as the history shows it (:class:`more_agent.records.ActionRecord` fits)."""
 
-    name: str
-    arguments: list[str]
-    ok: bool
-    feedback: str
+    @property
+    def name(self) -> str: ...
+    @property
+    def arguments(self) -> list[str]: ...
+    @property
+    def ok(self) -> bool: ...
+    @property
+    def feedback(self) -> str: ...
 
 
 def skill_api_text(skills: Iterable[Skill], *, vlm: bool = False) -> str:

@@ -52,7 +52,7 @@ def parse_llm_spec(spec: str) -> LLMSpec:
         raise BadLLMSpec(f"LLM spec {spec!r} names no model; {SPEC_HELP}")
     if kind == "llamacpp" and not model.lower().endswith(".gguf") and not is_bundled(model):
         raise BadLLMSpec(f"llamacpp model {model!r} is not a .gguf file nor a bundled model; {SPEC_HELP}")
-    return LLMSpec(kind=kind, model=model)  # type: ignore[arg-type]
+    return LLMSpec(kind=kind, model=model)
 
 
 def configured_llm(config: LLMConfig, cli_spec: str | None = None) -> LLMSpec | None:

@@ -126,7 +126,7 @@ def assign_objects(
     def near(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         d, i = tree.query(p, k=kk)
         d, i = np.atleast_1d(d), np.atleast_1d(i)
-        if blocked is not None:
+        if blocked is not None and grid is not None:  # both or neither (checked above)
             seen = line_of_sight(p, graph.xy[cand[i]], blocked, grid)
             if seen.any():
                 d, i = d[seen], i[seen]

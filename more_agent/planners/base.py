@@ -59,7 +59,7 @@ class HighLevelAction:
     note: str = ""
     """Why the planner chose it (an LLM's reasoning, the oracle's goal literal)."""
     gave_up: str = ""
-    """On a ``done`` with goals unmet on purpose: why the planner gives up (recorded as the episode's error)."""
+    """On a ``done`` with goals unmet on purpose: why the planner gives up (recorded as ``record.gave_up``)."""
 
     @property
     def is_done(self) -> bool:

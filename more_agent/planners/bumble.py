@@ -49,11 +49,18 @@ from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, Step
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
-from more_agent.planners.llm_planner import INVALID, filter_view, make_clients
+from more_agent.planners.llm_planner import filter_view, make_clients
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
-from more_agent.planners.visual_memory import MemoryConfig, MemoryFrame, VisualMemory, covering_frames, shows_points, spread
+from more_agent.planners.visual_memory import (
+    MemoryConfig,
+    MemoryFrame,
+    VisualMemory,
+    covering_frames,
+    shows_points,
+    spread,
+)
 from more_agent.planners.vlm_prompts import (
     FrameAnswer,
     MarkAnswer,
@@ -73,6 +80,7 @@ from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame
+from more_agent.skills import INVALID
 
 log = logging.getLogger(__name__)
 
@@ -365,7 +373,7 @@ class BumblePlanner:
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
+            return ActionResult(ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}")
         decision, body, graph = self.decision, self._body(), self._graph()
         if action.name == DONE:
             return run_skill(body, graph, DONE, None)

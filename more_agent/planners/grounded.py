@@ -50,8 +50,8 @@ import numpy as np
 
 from more_agent.mapping import visible_unknown_area
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.language import room_names
-from more_agent.planners.oracle import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type
@@ -63,9 +63,7 @@ from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.clutter import is_surface
 from more_agent.sim.goals import Literal
 from more_agent.sim.navgrid import XY
-
-FLOOR = "floor"
-"""Object argument of a placement on the floor of a room."""
+from more_agent.vocabulary import FLOOR
 
 MAX_FAILURES = 2
 """An action is not tried again after failing this many times the same way."""

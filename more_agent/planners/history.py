@@ -14,6 +14,7 @@ def append_action(history: list[ActionRecord], action: HighLevelAction, result: 
     later prompt through the history."""
     feedback = clip(result.feedback, MAX_FEEDBACK_CHARS)
     history.append(ActionRecord(
-        step=len(history), name=action.name, arguments=list(action.arguments), ok=result.ok, feedback=feedback,
+        step=len(history), name=action.name, arguments=list(action.arguments), ok=result.ok, reason=result.reason,
+        feedback=feedback,
     ))
     return f"{action.name}: {'success' if result.ok else 'failure'}; {feedback}"

@@ -29,12 +29,10 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.llm.answers import FilterResult
 from more_agent.scene_graph.model import ObjectNode, SceneGraph
+from more_agent.vocabulary import FLOOR
 
 UNLABELED_ROOM = "unknown_room"
 """Room name stem of regions the room classifier has not labelled yet."""
-
-FLOOR = "floor"
-"""Name of every room's floor in the scene text (floors are the rooms' ground, not graph objects)."""
 
 UNKNOWN_PLACE = "unknown"
 """Robot room shown when the robot is not in any region of the graph."""

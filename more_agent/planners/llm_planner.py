@@ -53,27 +53,17 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
-from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
+from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, HistoryMode, LLMUsage
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.skills import SKILLS, SKILLS_BY_NAME
+from more_agent.skills import INVALID, SKILLS, SKILLS_BY_NAME
+from more_agent.vocabulary import FLOOR, ROOM_TYPES
 
 log = logging.getLogger(__name__)
 
-INVALID = "invalid"
-"""Name of the action recorded when the LLM gave no usable answer after the re-asks."""
-
-ROOM_TYPES: tuple[str, ...] = (
-    "bar", "bathroom", "bedroom", "biology_lab", "break_room", "chemistry_lab", "childs_room", "classroom", "closet",
-    "computer_lab", "conference_hall", "copy_room", "corridor", "dining_room", "empty_room", "entryway",
-    "exercise_room", "garage", "garden", "grocery_store", "gym", "hammam", "infirmary", "kitchen", "living_room",
-    "lobby", "locker_room", "meeting_room", "pantry_room", "phone_room", "playroom", "private_office", "sauna",
-    "shared_office", "spa", "staircase", "storage_room", "television_room", "utility_room",
-)
-"""BEHAVIOR-1K room types (every type in bddl's combined_room_object_list.json): the room classifier's choices."""
 
 
 class LLMPlannerConfig(BaseModel):
@@ -244,7 +234,7 @@ class LLMPlanner:
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=f"invalid answer: {action.note}")
+            return ActionResult(ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}")
         body, graph, view = self._body(), self._graph(), self._view()
         params = SKILLS_BY_NAME[action.name].params
         if not params:  # done

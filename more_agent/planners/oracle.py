@@ -20,8 +20,10 @@ makes the oracle give up with a ``done`` whose ``gave_up`` says what failed and 
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Collection
 
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.policies import Embodiment
 from more_agent.records import LLMUsage
 from more_agent.scene_graph import SceneGraph
@@ -30,15 +32,9 @@ from more_agent.sim.env import ACTION_TYPES
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
 from more_agent.sim.predicates import ROBOT_NAME
-from more_agent.sim.tasks import REARRANGE_PREDICATES
 from more_agent.sim.world import World, WorldObject
 from more_agent.skills import skill_named
-
-ORACLE_PREDICATES = REARRANGE_PREDICATES
-"""Goal predicates the oracle knows how to achieve: those of a rearrangement."""
-
-PUT_DOWN_MAX_TOP_M = 1.5
-"""Furniture taller than this (trees, wardrobes) is not used to put things down on."""
+from more_agent.vocabulary import RELATIONS
 
 MAX_FAILURES_PER_ACTION = 2
 """The oracle gives up once the same action has failed this many times."""
@@ -64,30 +60,6 @@ def unsupported_reason(world: World, lit: Literal) -> str | None:
     return None
 
 
-def _group(lit: Literal) -> int:
-    """Order of literal kinds: open, removals, placements, closing, robot position."""
-    if lit.predicate == "open":
-        return 3 if lit.negated else 0
-    if lit.args[0] == ROBOT_NAME:
-        return 4
-    return 1 if lit.negated else 2
-
-
-def order_literals(literals: list[Literal]) -> list[Literal]:
-    """Literals in execution order: by kind, and placements so that what goes into / onto X comes before X moves."""
-    ordered = sorted(literals, key=_group)
-    placements = [lit for lit in ordered if _group(lit) == 2]
-    done: list[Literal] = []
-    todo = list(placements)
-    while todo:
-        # First literal none of whose subject's contents-to-be are still waiting; cycles fall back to order.
-        pick = next((lit for lit in todo if not any(o.args[1] == lit.args[0] for o in todo if o is not lit)), todo[0])
-        done.append(pick)
-        todo.remove(pick)
-    rest = iter(done)
-    return [next(rest) if _group(lit) == 2 else lit for lit in ordered]
-
-
 def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     """Drop duplicates and resolve one subject with several placements through the stack they imply.
 
@@ -98,7 +70,7 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     directly would undo the primary literal.
     """
     def placement(lit: Literal) -> bool:
-        return lit.predicate in ("inside", "ontop") and not lit.negated and lit.args[0] != ROBOT_NAME
+        return lit.predicate in RELATIONS and not lit.negated and lit.args[0] != ROBOT_NAME
 
     primary: dict[str, Literal] = {}
     for lit in literals:
@@ -115,7 +87,7 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     return out
 
 
-def choose_option(goals: GoalChecker, world: World, exclude: set[int] = frozenset()) -> int | None:
+def choose_option(goals: GoalChecker, world: World, exclude: Collection[int] = frozenset()) -> int | None:
     """The ground goal option (not in ``exclude``) with the fewest literals the oracle cannot achieve, then the fewest unmet."""
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)

@@ -28,15 +28,13 @@ from typing import Any
 
 from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
-from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.instantiate import TaskInstance
+from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import scope_synset
+from more_agent.vocabulary import FLOOR_SYNSETS
 
 _FLOOR = re.compile(r"^the (.+) floor$")
-
-FLOOR_SYNSETS = frozenset({"floor.n.01", "lawn.n.01", "driveway.n.01", "carpet.n.01"})
-"""Synsets of room grounds: their scopes are floors, placed on where the robot stands."""
 
 
 @dataclass(frozen=True)

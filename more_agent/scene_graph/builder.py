@@ -146,7 +146,7 @@ class SceneGraphBuilder:
                 self._remembered.add(iid)
         self._carried = carried
 
-    def remember(self, iid: int, box_min: Sequence[float], box_max: Sequence[float]) -> None:
+    def remember(self, iid: int, box_min: Sequence[float] | np.ndarray, box_max: Sequence[float] | np.ndarray) -> None:
         """An instance the robot put down itself: kept in the graph with this box (world metres) while
         no frame shows it (e.g. deep in a basket), until it is held again."""
         self._boxes[iid] = (np.asarray(box_min, dtype=float), np.asarray(box_max, dtype=float))

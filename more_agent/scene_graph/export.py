@@ -39,9 +39,9 @@ def to_networkx(graph: SceneGraph, *, include_nav: bool = False) -> nx.DiGraph:
     if include_nav:
         for i, xy in enumerate(graph.nav.node_xy.tolist()):
             g.add_node(f"nav_{i}", layer="nav", xy=tuple(xy))
-            region = graph.nav.node_region[i]
-            if region is not None:
-                g.add_edge(region, f"nav_{i}", kind="covers")
+            region_id = graph.nav.node_region[i]
+            if region_id is not None:
+                g.add_edge(region_id, f"nav_{i}", kind="covers")
         for (a, b), w in zip(graph.nav.edges.tolist(), graph.nav.weights.tolist()):
             g.add_edge(f"nav_{a}", f"nav_{b}", kind="nav", weight=w)
             g.add_edge(f"nav_{b}", f"nav_{a}", kind="nav", weight=w)

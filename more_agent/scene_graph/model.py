@@ -16,12 +16,13 @@ robot holds at most one object.
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Literal
+from typing import Annotated
 
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PlainSerializer, PrivateAttr, model_validator
 from scipy.spatial import cKDTree
 
+from more_agent import vocabulary
 from more_agent.sim.grid import Grid
 
 SCHEMA_VERSION = 2
@@ -30,17 +31,16 @@ Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
 
-def _array(dtype: type) -> object:
-    return Annotated[
-        np.ndarray,
-        BeforeValidator(lambda v: np.asarray(v, dtype=dtype)),
-        PlainSerializer(lambda a: a.tolist(), return_type=list),
-    ]
+def _as(dtype: type) -> BeforeValidator:
+    """Validation into a numpy array of ``dtype`` (JSON gives lists)."""
+    return BeforeValidator(lambda v: np.asarray(v, dtype=dtype))
 
 
-FloatArray = _array(np.float64)
-IntArray = _array(np.int64)
-BoolArray = _array(np.bool_)
+_AS_LIST = PlainSerializer(lambda a: a.tolist(), return_type=list)
+
+FloatArray = Annotated[np.ndarray, _as(np.float64), _AS_LIST]
+IntArray = Annotated[np.ndarray, _as(np.int64), _AS_LIST]
+BoolArray = Annotated[np.ndarray, _as(np.bool_), _AS_LIST]
 
 
 class Layer(str, Enum):
@@ -63,7 +63,7 @@ class InstanceInfo(_Model):
     category: str = Field(description="Object category, e.g. 'fridge', 'door', 'apple'.")
     open: bool | None = Field(default=None, description="Open state; None when not openable.")
     held: bool = Field(default=False, description="True while the robot holds it.")
-    rests: tuple[Literal["inside", "ontop"], str | None] | None = Field(
+    rests: tuple[vocabulary.Relation, str | None] | None = Field(
         default=None,
         description="How it rests as perceived: ('inside' | 'ontop', label of the container / support, None for "
         "the floor). None when not reported: the builder then derives relations from box geometry.",
@@ -105,7 +105,7 @@ class Relation(_Model):
     """A spatial relation derived from geometry: subject <predicate> object."""
 
     subject: str = Field(description="Object id of the contained / supported object.")
-    predicate: Literal["inside", "ontop"] = Field(description="Relation type.")
+    predicate: vocabulary.Relation = Field(description="Relation type.")
     object: str = Field(description="Object id of the container / support.")
 
 

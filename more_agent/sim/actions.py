@@ -20,16 +20,17 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from enum import Enum
 
 import numpy as np
 
+from more_agent.records import FailureReason
+from more_agent.robot_spec import ROBOT
 from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
 from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
-REACH_M = 1.5
-"""Largest horizontal distance from the robot base to an object's footprint for a manipulation."""
+REACH_M = ROBOT.reach_m
+"""Largest horizontal distance from the robot base to an object's footprint for a manipulation (``RobotSpec.reach_m``)."""
 
 CLEARANCE_M = 0.45
 """Distance added to an object's half-diagonal for the navigation circle."""
@@ -51,24 +52,6 @@ FORWARD_STEP_M = 0.075
 
 MAX_TURN_RAD = math.radians(35)
 """Largest low-level turn (paper S.3)."""
-
-
-class FailureReason(str, Enum):
-    """Why a magic action failed."""
-
-    UNKNOWN_OBJECT = "unknown_object"
-    HIDDEN = "hidden"
-    NOT_REACHABLE = "not_reachable"
-    PATH_BLOCKED_BY_DOOR = "path_blocked_by_door"
-    TOO_FAR = "too_far"
-    HAND_FULL = "hand_full"
-    HAND_EMPTY = "hand_empty"
-    NOT_OPENABLE = "not_openable"
-    ALREADY_OPEN = "already_open"
-    ALREADY_CLOSED = "already_closed"
-    NOT_GRASPABLE = "not_graspable"
-    TARGET_CLOSED = "target_closed"
-    INVALID_TARGET = "invalid_target"
 
 
 @dataclass(frozen=True)

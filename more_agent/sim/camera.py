@@ -6,11 +6,11 @@ camera coordinates to world coordinates. Pixel (u, v) has its centre at integer 
 ``K @ p_cam / p_cam[2]`` gives column / row indices directly and the principal point of a
 symmetric image is ((W - 1) / 2, (H - 1) / 2).
 
-Geometry (see docs/sensors.md for the reasons): 256 x 256 pixels, the field of view of OmniGibson's
-Fetch head camera (63.3 degrees horizontally, :data:`HFOV_DEG`) with square pixels (so 63.3 degrees
-vertically too), mounted 1.2 m above the ground (the Fetch head camera with the torso lowered) and
-pitched 20 degrees down, 5 m range. With these values the ground is visible from 0.95 m in front of
-the robot and a 2.1 m door lintel from 4.4 m away.
+Geometry (see docs/sensors.md for the reasons) is the robot's, :attr:`more_agent.robot_spec.RobotSpec.camera`:
+256 x 256 pixels, the field of view of OmniGibson's Fetch head camera (63.3 degrees horizontally) with
+square pixels (so 63.3 degrees vertically too), mounted 1.2 m above the ground (the Fetch head camera
+with the torso lowered) and pitched 20 degrees down, 5 m range. The constants below name those values
+for this module's callers.
 """
 
 from __future__ import annotations
@@ -20,25 +20,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-IMAGE_SIZE = 256
+from more_agent.robot_spec import ROBOT
+
+IMAGE_SIZE = ROBOT.camera.image_size
 """Width and height of every frame in pixels (paper S.2)."""
 
-OMNIGIBSON_FOCAL_LENGTH_MM = 17.0
-"""Focal length OmniGibson's ``VisionSensor`` sets on every robot camera, the Fetch's head camera included."""
+HFOV_DEG = ROBOT.camera.hfov_deg
+"""Horizontal field of view in degrees."""
 
-USD_HORIZONTAL_APERTURE_MM = 20.955
-"""Horizontal aperture of a USD camera that sets none (OmniGibson leaves the USD default)."""
-
-HFOV_DEG = math.degrees(2 * math.atan(USD_HORIZONTAL_APERTURE_MM / (2 * OMNIGIBSON_FOCAL_LENGTH_MM)))
-"""Horizontal field of view in degrees: the paper's Fetch in OmniGibson, 63.3 degrees."""
-
-PITCH_DEG = 20.0
+PITCH_DEG = ROBOT.camera.pitch_deg
 """Fixed downward tilt of the optical axis below the horizon, in degrees."""
 
-HEAD_HEIGHT_M = 1.2
+HEAD_HEIGHT_M = ROBOT.camera.height_m
 """Height of the optical centre above the ground in metres."""
 
-MAX_RANGE_M = 5.0
+MAX_RANGE_M = ROBOT.camera.max_range_m
 """Sensor range: pixels whose z-depth exceeds it are invalid (paper S.2)."""
 
 

@@ -29,7 +29,9 @@ import numpy as np
 
 from more_agent.sim import catalog
 from more_agent.sim.floorspots import free_floor_spot
-from more_agent.sim.world import Relation, World, WorldObject, floor_name
+from more_agent.sim.packing import support_surface
+from more_agent.sim.world import World, WorldObject, floor_name
+from more_agent.vocabulary import Relation
 
 MAX_PER_CATEGORY = 32
 """Most items of one category per room (a store lists 1,411 apples: a few full shelf rows stay)."""
@@ -223,13 +225,13 @@ class _RoomPlacer:
 
 
 def _surface_area(world: World, support: WorldObject, relation: Relation) -> float:
-    lo, hi, _ = world.support_surface(support, relation)
+    lo, hi, _ = support_surface(support, relation)
     return float(max(hi[0] - lo[0], 0.0) * max(hi[1] - lo[1], 0.0))
 
 
 def _fits(world: World, obj: WorldObject, support: WorldObject, relation: Relation) -> bool:
     """Whether the item's footprint fits the support's surface and, inside, its height fits the interior."""
-    lo, hi, z = world.support_surface(support, relation)
+    lo, hi, z = support_surface(support, relation)
     if np.any(obj.size[:2] > hi - lo):
         return False
     return relation == "ontop" or z + obj.size[2] <= support.top - 0.02

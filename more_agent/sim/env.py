@@ -115,12 +115,12 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         cam = self.renderer.camera
         hw = (cam.height, cam.width)
         ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
-        state = {
+        state: dict[str, spaces.Space[Any]] = {
             "robot_pose": spaces.Box(np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
                                      np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]), (3,), np.float64),
             "held": spaces.Box(0, _INT32_MAX, (), np.int32),
         }
-        self.observation_space = spaces.Dict(state if not sensors else {
+        self.observation_space = spaces.Dict(state if not sensors else {  # type: ignore[assignment]  # a Dict space
             "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
             "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
             "semantic": ids,
@@ -191,6 +191,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             if name is None:
                 ok, reason, feedback, steps = False, "unknown_object", f"unknown object {target!r}", 0
             else:
+                assert kind is not None  # parsed without error
                 act = actions.navigate_to(self.world, name) if kind == "navigate_to" else actions.go_to_and(self.world, kind, name)
                 ok, reason, feedback, steps = act.ok, act.reason.value if act.reason else None, act.feedback, act.low_level_steps
                 path, blocking = list(act.path), act.blocking

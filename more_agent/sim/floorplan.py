@@ -19,6 +19,7 @@ import numpy as np
 from more_agent.sim import catalog
 from more_agent.sim.furnish import furnish_room
 from more_agent.sim.scene import Door, Furniture, GroundPatch, Room, Scene, Wall, Window
+from more_agent.vocabulary import OUTDOOR_ROOM_TYPES, room_type
 
 Rect = tuple[float, float, float, float]
 
@@ -36,7 +37,13 @@ TYPICAL_AREA_M2: dict[str, tuple[float, float]] = {
 }
 """Plausible (min, max) floor area per BEHAVIOR room type; others get (10, 20)."""
 
-OUTDOOR_TYPES = frozenset({"garden"})
+FURNISH_RADIUS_M = 0.3
+"""Robot radius rooms are furnished for: the robot's (``RobotSpec.radius_m``, 0.2 m) plus a 0.1 m margin."""
+
+FURNISH_REACH_M = 1.0
+"""Reach every piece of furniture must be within from the free floor: 0.5 m short of the robot's
+(``RobotSpec.reach_m``), so that every generated piece is comfortably reachable."""
+
 DOOR_HEIGHT_M = 2.1
 WINDOW_SILL_M, WINDOW_TOP_M = 0.9, 2.0
 FENCE_HEIGHT_M = 1.0
@@ -93,8 +100,8 @@ def generate_floorplan(
     clearance_factor: float = 2.5,
     walkway_m: float = 0.8,
     door_clear_m: float = 1.0,
-    robot_radius_m: float = 0.3,
-    reach_m: float = 1.0,
+    robot_radius_m: float = FURNISH_RADIUS_M,
+    reach_m: float = FURNISH_REACH_M,
     resolution_m: float = 0.075,
     max_attempts: int = 12,
 ) -> Scene:
@@ -126,9 +133,9 @@ def generate_floorplan(
         return Scene(
             name=name, seed=seed, wall_height=wall_height_m,
             bounds=_round((min(allx) - pad, min(ally) - pad, max(allx) + pad, max(ally) + pad)),
-            rooms=[Room(id=rid, type=_room_type(rid), bounds=rects[rid],
-                        ground="lawn" if _room_type(rid) in OUTDOOR_TYPES else "floor",
-                        outdoor=_room_type(rid) in OUTDOOR_TYPES) for rid in rooms],
+            rooms=[Room(id=rid, type=room_type(rid), bounds=rects[rid],
+                        ground="lawn" if room_type(rid) in OUTDOOR_ROOM_TYPES else "floor",
+                        outdoor=room_type(rid) in OUTDOOR_ROOM_TYPES) for rid in rooms],
             walls=walls, doors=doors, windows=windows, furniture=furniture, ground_patches=patches,
         )
     raise RuntimeError(f"could not lay out scene {name!r} in {max_attempts} attempts")
@@ -139,8 +146,10 @@ def scene_rng(name: str, seed: int) -> np.random.Generator:
     return np.random.default_rng([seed, zlib.crc32(name.encode())])
 
 
-def _room_type(room_id: str) -> str:
-    return room_id.rsplit("_", 1)[0]
+def _rect(v: tuple[float, ...]) -> Rect:
+    """``v`` as a rectangle (x0, y0, x1, y1)."""
+    x0, y0, x1, y1 = v
+    return (x0, y0, x1, y1)
 
 
 def _round(v: tuple[float, ...], nd: int = 3) -> tuple[float, ...]:
@@ -169,14 +178,14 @@ def _room_items(objs: dict[str, int], wall_top_m: float = 2.5) -> list[_Item]:
 
 
 def _room_area(room_id: str, items: list[_Item], rng: np.random.Generator, clearance: float, k: dict) -> float:
-    lo, hi = TYPICAL_AREA_M2.get(_room_type(room_id), (10.0, 20.0))
+    lo, hi = TYPICAL_AREA_M2.get(room_type(room_id), (10.0, 20.0))
     floor = [it for it in items if it.role in ("floor", "free")]
     footprint = sum(it.size[0] * it.size[1] for it in floor)
     # random sequential packing fills about half the plane with walkway-inflated free pieces
     free = sum((it.size[0] + k["walk"]) * (it.size[1] + k["walk"]) for it in floor if it.role == "free")
     walled = sum(max(it.size[:2]) * (min(it.size[:2]) + k["walk"]) for it in floor if it.role == "floor")
     need = max(clearance * footprint, 2.0 * free + 1.3 * walled) + 4.0
-    if _room_type(room_id) in OUTDOOR_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items):
+    if room_type(room_id) in OUTDOOR_ROOM_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items):
         need += 30.0
     return max(float(rng.uniform(lo, hi)), need)
 
@@ -223,8 +232,8 @@ def _squarify(areas: list[float], rect: Rect) -> list[Rect]:
 def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[str, Rect]:
     """Room rectangles: indoor rooms tile the house, outdoor ones are bands along its sides."""
     areas = {rid: _room_area(rid, items[rid], rng, clearance, k) * growth[rid] for rid in rooms}
-    indoor = [rid for rid in rooms if _room_type(rid) not in OUTDOOR_TYPES]
-    outdoor = [rid for rid in rooms if _room_type(rid) in OUTDOOR_TYPES]
+    indoor = [rid for rid in rooms if room_type(rid) not in OUTDOOR_ROOM_TYPES]
+    outdoor = [rid for rid in rooms if room_type(rid) in OUTDOOR_ROOM_TYPES]
     rects: dict[str, Rect] = {}
     w = h = 0.0
     if indoor:
@@ -236,7 +245,7 @@ def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[s
         jitter = rng.uniform(0.85, 1.15, size=len(indoor))
         order = sorted(range(len(indoor)), key=lambda i: -areas[indoor[i]] * jitter[i])
         tiles = _squarify([areas[indoor[i]] for i in order], (0.0, 0.0, w, h))
-        rects = {indoor[i]: _round(t, 2) for i, t in zip(order, tiles)}
+        rects = {indoor[i]: _rect(_round(t, 2)) for i, t in zip(order, tiles)}
     long_sides, short_sides = (["S", "N"], ["E", "W"]) if w >= h else (["E", "W"], ["S", "N"])
     sides = [str(s) for s in rng.permutation(long_sides)] + [str(s) for s in rng.permutation(short_sides)]
     offset = dict.fromkeys(sides, 0.0)
@@ -247,8 +256,8 @@ def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[s
             length = areas[rid] ** 0.5
         depth = max(areas[rid] / length, 7.0)
         o = offset[side]
-        rects[rid] = _round({"S": (0, -o - depth, length, -o), "N": (0, h + o, length, h + o + depth),
-                             "W": (-o - depth, 0, -o, length), "E": (w + o, 0, w + o + depth, length)}[side], 2)
+        rects[rid] = _rect(_round({"S": (0, -o - depth, length, -o), "N": (0, h + o, length, h + o + depth),
+                             "W": (-o - depth, 0, -o, length), "E": (w + o, 0, w + o + depth, length)}[side], 2))
         offset[side] = o + depth
     return rects
 
@@ -298,7 +307,7 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k) -> list[Door] | 
     tree = {tuple(sorted(e)) for e in nx.minimum_spanning_edges(g, data=False)}
     doors: list[Door] = []
     for key in sorted(best):
-        outdoor = any(_room_type(r) in OUTDOOR_TYPES for r in key)
+        outdoor = any(room_type(r) in OUTDOOR_ROOM_TYPES for r in key)
         if key not in tree and (outdoor or rng.random() >= extra_p):
             continue
         run = best[key]
@@ -322,7 +331,7 @@ def _place_windows(runs, doors, rng, k) -> list[Window]:
     out: list[Window] = []
     for run in runs:
         sides = [r for r in (run.neg, run.pos) if r]
-        indoor = [r for r in sides if _room_type(r) not in OUTDOOR_TYPES]
+        indoor = [r for r in sides if room_type(r) not in OUTDOOR_ROOM_TYPES]
         if len(indoor) != 1 or run.hi - run.lo < 1.8:
             continue
         busy = [a for a in (_on_run(run, d.center) for d in doors) if a is not None]
@@ -346,7 +355,7 @@ def _walls(runs, doors, windows, height, k) -> list[Wall]:
     out: list[Wall] = []
     t = k["t"]
     for run in runs:
-        indoor = any(r and _room_type(r) not in OUTDOOR_TYPES for r in (run.neg, run.pos))
+        indoor = any(r and room_type(r) not in OUTDOOR_ROOM_TYPES for r in (run.neg, run.pos))
         top = height if indoor else FENCE_HEIGHT_M
         gaps = []
         for d in doors:
@@ -403,7 +412,7 @@ def _furnish_all(rects, items, doors, windows, rng, k) -> tuple[list[Furniture],
     for rid, rect in rects.items():
         keep = _keepouts(rid, rect, doors, windows, k)
         driveway = None
-        if _room_type(rid) in OUTDOOR_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items[rid]):
+        if room_type(rid) in OUTDOOR_ROOM_TYPES and any(it.category in catalog.VEHICLE_CATEGORIES for it in items[rid]):
             driveway = _driveway(rid, rect, rects, k)
             patches.append(GroundPatch(room=rid, bounds=_round(driveway), ground="driveway"))
         placed = furnish_room(rect, items[rid], keep, rng, driveway=driveway, k=k)

@@ -8,6 +8,8 @@ grid (robot disc inflated, flood fill from the doors) and the room is refurnishe
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from scipy import ndimage
 
@@ -63,7 +65,7 @@ def furnish_room(
     driveway: Rect | None,
     k: dict,
     attempts: int = 6,
-) -> list[tuple[object, Vec3, Vec3]] | None:
+) -> list[tuple[Any, Vec3, Vec3]] | None:
     """Place ``items`` in the room; returns (item, centre, rotated size) per item, or None on failure."""
     m = k["t"] / 2 + _WALL_CLEAR_M
     inner = (rect[0] + m, rect[1] + m, rect[2] - m, rect[3] - m)

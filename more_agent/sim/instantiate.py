@@ -12,7 +12,7 @@ Steps (all deterministic for a given task, scene and seed):
    ('apple.n.01_1' -> 'apple_1').
 4. Placement literals run supports first (topological order): ``ontop``/``inside`` rest the item on
    / in its support (on a floor: at a free spot sampled against furniture, walls, doors and other
-   floor items; elsewhere at a free slot that no other box reaches into, ``sim.world.free_slot``:
+   floor items; elsewhere at a free slot that no other box reaches into, ``sim.packing.free_slot``:
    not inside a TV standing on the same table, on the highest level within reach of a tall shelf);
    ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
    ``touching`` on the floor beside the other object, or on the same support when that object is
@@ -47,6 +47,7 @@ from more_agent.sim.descriptions import check_description_mode, description_temp
 from more_agent.sim.fixtures import hang_listed_fixtures
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.matching import maximum_matching
+from more_agent.sim.packing import support_surface
 from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
 from more_agent.sim.scene import Scene
 from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
@@ -377,10 +378,10 @@ class _Builder:
             if pred == "inside" and support.openable and atom[2] not in opened:
                 support.is_open = False
         elif pred == "under":
-            floor = floor_name(support.room)
+            floor = floor_name(support.room)  # type: ignore[arg-type]  # a support stands in a room
             self.world.place_on_floor_at(a, floor, (float(support.center[0]), float(support.center[1])))
         elif support.parent is None or self.world.objects[support.parent].kind == "floor" or support.kind != "item":
-            self._on_free_floor(a, floor_name(support.room), near=support)
+            self._on_free_floor(a, floor_name(support.room), near=support)  # type: ignore[arg-type]  # as above
         else:
             self._on_support(a, support.parent, support.relation or "ontop", atom)
 
@@ -390,12 +391,12 @@ class _Builder:
         fails this scene). An item with no slot as it comes is turned a quarter and tried again when
         its turned footprint lies within the surface (the slot grid follows the item's footprint:
         a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
-        if self.world.place_if_room(name, support, relation, stack=True):
+        if self.world.place_if_room(name, support, relation, stack=True):  # type: ignore[arg-type]  # ontop / inside
             return
         obj = self.world.objects[name]
-        lo, hi, _ = self.world.support_surface(self.world.objects[support], relation)
+        lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
         obj.size = obj.size[[1, 0, 2]]
-        if not (np.all(obj.size[:2] <= hi - lo) and self.world.place_if_room(name, support, relation, stack=True)):
+        if not (np.all(obj.size[:2] <= hi - lo) and self.world.place_if_room(name, support, relation, stack=True)):  # type: ignore[arg-type]
             obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 

@@ -29,6 +29,7 @@ from scipy import ndimage
 from skimage.graph import MCP_Geometric
 from skimage.measure import approximate_polygon
 
+from more_agent.robot_spec import ROBOT
 from more_agent.sim.grid import Grid
 from more_agent.sim.scene import Bounds2D, Door
 from more_agent.sim.world import World
@@ -43,8 +44,8 @@ class NavConfig:
     resolution_m: float = 0.075
     """Cell size in metres (the paper's map resolution)."""
 
-    robot_radius_m: float = 0.2
-    """Clearance kept from walls, closed doors and furniture; small enough for 0.9 m doors and 0.8 m corridors."""
+    robot_radius_m: float = ROBOT.radius_m
+    """Clearance kept from walls, closed doors and furniture (the robot's radius, ``RobotSpec.radius_m``)."""
 
     door_passage_m: float = 0.3
     """How far a door's passage strip reaches into the rooms on either side (bridges wall thickness)."""
@@ -72,7 +73,7 @@ class NavGrid(Grid):
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.free.shape  # type: ignore[return-value]
+        return self.free.shape
 
     def cell_at(self, x: float, y: float) -> tuple[int, int]:
         """The (ix, iy) of the cell containing (x, y), clipped to the grid."""

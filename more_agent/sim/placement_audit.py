@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from more_agent.sim.world import REACH_TOP_M, World
+from more_agent.sim.packing import REACH_TOP_M
+from more_agent.sim.world import World
 
 TOLERANCE_M = 0.01
 """How far an item may stick out of a box and still count as enclosed by it."""

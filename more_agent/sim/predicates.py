@@ -62,7 +62,7 @@ def is_ontop(world: World, name: str, support: str) -> bool:
     if obj is None:
         return False
     if obj.kind == "furniture":
-        return support == floor_name(obj.room)
+        return obj.room is not None and support == floor_name(obj.room)
     for parent, rel in world.ancestors(name):
         if rel != "ontop":
             return False

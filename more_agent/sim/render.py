@@ -33,7 +33,8 @@ from numba import njit
 
 from more_agent.sim.camera import Camera
 from more_agent.sim.grid import Grid
-from more_agent.sim.world import SLAB_FRACTION, World, WorldObject
+from more_agent.sim.packing import SLAB_FRACTION
+from more_agent.sim.world import World, WorldObject
 
 GRID_CELL_M = 1.0
 """Side of the acceleration grid's cells in metres."""

@@ -16,7 +16,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationErr
 
 from more_agent.errors import UserError
 
-SCENE_SCHEMA_VERSION = 1
+SCENE_SCHEMA_VERSION: Literal[1] = 1
 
 GroundClass = Literal["floor", "carpet", "lawn", "driveway"]
 """Ground classes; all four are free space for the robot (paper S.2)."""

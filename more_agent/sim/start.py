@@ -74,7 +74,7 @@ def random_start(
     free = np.isin(components, keep[keep > 0])
     if by_room:
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
-        xy = grid.xy_of(np.stack(np.indices(grid.shape), axis=-1))
+        xy = grid.xy_of(np.stack(list(np.indices(grid.shape)), axis=-1))
         x, y = xy[..., 0], xy[..., 1]
         in_room = [free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
                    for r in world.scene.rooms]
@@ -84,9 +84,9 @@ def random_start(
     cells = free_cells(free)
     if len(cells) == 0:
         return None
-    x, y = grid.centre(cells[rng.integers(len(cells))])
+    cx, cy = grid.centre(cells[rng.integers(len(cells))])
     jitter = rng.uniform(-0.5, 0.5, size=2) * grid.resolution_m
-    return float(x + jitter[0]), float(y + jitter[1]), float(rng.uniform(-np.pi, np.pi))
+    return float(cx + jitter[0]), float(cy + jitter[1]), float(rng.uniform(-np.pi, np.pi))
 
 
 def start_to_task_m(world: World, targets: list[str]) -> float | None:

@@ -233,7 +233,8 @@ def scene_mismatch(task: TaskDefinition, rooms: dict[str, dict[str, int]]) -> st
             continue
         missing = [room_matches(rooms[r], required) for r in candidates]
         if all(missing):
-            reasons.append(f"no {room_type} has {', '.join(min(missing, key=len))}")
+            fewest: list[str] = min(missing, key=len)
+            reasons.append(f"no {room_type} has {', '.join(fewest)}")
     return "; ".join(reasons)
 
 

@@ -3,7 +3,8 @@
 The world is symbolic where the paper's magic actions are (what rests inside / on top of what, what
 is open, what is held) and geometric where sensing and navigation need it (axis-aligned boxes).
 Positions of movable items are derived from their support: an item placed on or in a parent takes
-the first free slot on the parent's top surface or interior floor. Nothing here knows about tasks,
+the first free slot on the parent's top surface or interior floor (:mod:`more_agent.sim.packing`
+says where; the world only rests it there). Nothing here knows about tasks,
 actions or rendering; they read and change the world through this API.
 """
 
@@ -13,92 +14,21 @@ import re
 import string
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 
+from more_agent.sim import packing
+from more_agent.sim.objects import WorldObject
 from more_agent.sim.scene import STRUCTURAL_CLASSES, Scene
-
-Relation = Literal["inside", "ontop"]
-ObjectKind = Literal["floor", "door", "furniture", "item"]
-
-SLAB_FRACTION = 0.08
-"""Thickness of a container's bottom / top slab as a share of its height (inner items rest on it)."""
-
-SLOT_GAP_M = 0.02
-"""Gap left between neighbouring items on one support."""
+from more_agent.vocabulary import Relation
 
 CARRY_HEIGHT_M = 1.0
 """Height of a held item's centre, above the robot base."""
-
-REACH_TOP_M = 1.6
-"""Highest surface the arm places on (the Fetch arm with its torso lowered, like the 1.2 m camera, which
-sees items there from about a metre away). A support with inner levels whose top is higher takes
-items on top on its highest level at most this high (``support_surface``)."""
-
-LEVELLED_CATEGORIES = frozenset(
-    """shelf bookcase grocery_shelf commercial_kitchen_shelf candy_dispenser_shelf dry_food_dispenser_shelf
-    shoe_rack magazine_rack snack_rack""".split()
-)
-"""Supports with inner shelf levels: BEHAVIOR-1K's ``ontop`` holds on any of their levels."""
-
-LEVEL_STEP_M = 0.4
-"""Spacing of the inner levels of a ``LEVELLED_CATEGORIES`` support, from its bottom slab up."""
-
-MAX_FOLDS = 3
-"""Times a cloth item is folded in half, at most, to fit where it is put (``World.fit``)."""
-
-CLOTH_LAYER_M = 0.01
-"""Thickness of one layer of cloth: a garment folded n times lies 2^n layers thick (``World.fit``)."""
 
 
 def floor_name(room_id: str) -> str:
     """Name of the floor object of a room (every room has one)."""
     return f"floor_{room_id}"
-
-
-@dataclass
-class WorldObject:
-    """One object of the world. ``center`` / ``size`` describe its axis-aligned box in metres."""
-
-    name: str
-    category: str
-    kind: ObjectKind
-    center: np.ndarray
-    size: np.ndarray
-    room: str | None = None
-    synset: str | None = None
-    label: str = ""
-    openable: bool = False
-    is_open: bool = False
-    cloth: bool = False
-    """Folds to fit where it rests (``World.fit``), as BEHAVIOR-1K's deformable garments crumple."""
-    parent: str | None = None
-    relation: Relation | None = None
-    instance_id: int = 0
-
-    @property
-    def movable(self) -> bool:
-        """Items can be grasped and placed; floors, doors and furniture stay put."""
-        return self.kind == "item"
-
-    def box(self) -> tuple[np.ndarray, np.ndarray]:
-        """(min corner, max corner) of the box."""
-        half = self.size / 2
-        return self.center - half, self.center + half
-
-    def footprint(self) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) of the box seen from above."""
-        (x0, y0, _), (x1, y1, _) = self.box()
-        return float(x0), float(y0), float(x1), float(y1)
-
-    @property
-    def top(self) -> float:
-        return float(self.center[2] + self.size[2] / 2)
-
-    @property
-    def bottom(self) -> float:
-        return float(self.center[2] - self.size[2] / 2)
 
 
 @dataclass
@@ -162,8 +92,7 @@ class World:
         obj.instance_id = len(self.objects) + 1
         self.semantic_id(obj.category)
         self.objects[obj.name] = obj
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
         return obj
 
     def semantic_id(self, category: str) -> int:
@@ -277,18 +206,17 @@ class World:
         if not obj.openable:
             raise ValueError(f"{name} is not openable")
         obj.is_open = is_open
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def place(self, name: str, parent: str, relation: Relation) -> None:
         """Rest item ``name`` inside / on top of ``parent`` at the first free slot (no precondition checks)."""
         obj, support = self.objects[name], self.objects[parent]
-        self._rest(obj, support, relation, *self._magic_fit(obj, support, relation))
+        self._rest(obj, support, relation, *packing.magic_fit(obj, support, relation, self._in_the_way(obj, support)))
 
     def place_if_room(self, name: str, parent: str, relation: Relation, *, stack: bool = False) -> bool:
-        """Like ``place``, but only where it fits (``fit``); False (nothing changed) when it does not."""
+        """Like ``place``, but only where it fits (``packing.fit``); False (nothing changed) when it does not."""
         obj, support = self.objects[name], self.objects[parent]
-        fitted = self.fit(obj, support, relation, stack=stack)
+        fitted = packing.fit(obj, support, relation, self._in_the_way(obj, support), stack=stack)
         if fitted is None:
             return False
         self._rest(obj, support, relation, *fitted)
@@ -306,8 +234,7 @@ class World:
         self._move_subtree(obj, center)
         if self.robot.held == obj.name:
             self.robot.held = None
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def pick(self, name: str) -> None:
         """Put item ``name`` in the robot's gripper, detached from its support (no precondition checks)."""
@@ -315,15 +242,27 @@ class World:
         obj.parent, obj.relation = None, None
         self.robot.held = name
         self._carry()
-        self.version += 1
-        self.layout_version += 1
+        self._changed(layout=True)
 
     def set_robot_pose(self, x: float, y: float, yaw: float) -> None:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
+        self._changed(layout=self.robot.held is not None)  # a held item moved along
+
+    def _in_the_way(self, obj: WorldObject, support: WorldObject) -> list[WorldObject]:
+        """What may stand where ``obj`` goes on ``support`` (``packing``): items already there and anything
+        else (a TV on the coffee table, a shelf hung above a desk), but no floor, not the supports of
+        ``support`` nor ``obj``, its load or the held item."""
+        skip = {obj.name, support.name, self.robot.held} | {o.name for o in self.descendants(obj.name)}
+        skip |= {parent.name for parent, _ in self.ancestors(support.name)}
+        return [o for o in self.objects.values() if o.kind != "floor" and o.name not in skip]
+
+    def _changed(self, *, layout: bool) -> None:
+        """The one place the versions move: ``version`` on every change, ``layout_version`` when an
+        object changed (pose, support, open state), not when the robot merely moved."""
         self.version += 1
-        if self.robot.held is not None:  # the held item moved along
+        if layout:
             self.layout_version += 1
 
     def _carry(self) -> None:
@@ -340,126 +279,6 @@ class World:
         for d in self.descendants(obj.name):
             d.center = d.center + delta
             d.room = obj.room
-
-    # -- geometry helpers -----------------------------------------------------------------------
-    def support_surface(self, support: WorldObject, relation: Relation) -> tuple[np.ndarray, np.ndarray, float]:
-        """(footprint min xy, footprint max xy, surface z) where items rest in / on ``support``."""
-        lo, hi = support.box()
-        if relation == "ontop":
-            return lo[:2], hi[:2], _top_level(support)
-        slab = SLAB_FRACTION * support.size[2]
-        margin = np.minimum(0.05, support.size[:2] * 0.1)
-        return lo[:2] + margin, hi[:2] - margin, support.bottom + slab
-
-    def _magic_fit(self, obj: WorldObject, support: WorldObject, relation: Relation) -> tuple[np.ndarray, np.ndarray]:
-        """Centre and size where ``obj`` fits, stacking when the surface is full (``fit``), else the
-        support's centre: magic placement, like the paper's, never fails for lack of room."""
-        fitted = self.fit(obj, support, relation, stack=True)
-        if fitted is not None:
-            return fitted
-        lo, hi, z = self.support_surface(support, relation)
-        cx, cy = (lo + hi) / 2
-        return np.array([cx, cy, z + obj.size[2] / 2]), obj.size
-
-    def fit(self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
-        """(centre, size) of ``obj`` at its first free slot (``free_slot``) in its own shape or, for
-        cloth, folded in half up to ``MAX_FOLDS`` times, as a garment goes into a washer or a carton;
-        None when no shape fits. A fold halves the longer side and lays the garment flat, 2^folds
-        layers of cloth thick at most (a garment model's box is a draped heap, mostly air)."""
-        lo, hi, _ = self.support_surface(support, relation)
-        size, folds = obj.size, MAX_FOLDS if obj.cloth else 0
-        for fold in range(folds + 1):
-            if fold:
-                size = size * np.where(np.arange(3) == np.argmax(size[:2]), 0.5, 1.0)
-                size[2] = min(size[2], CLOTH_LAYER_M * 2**fold)
-            if fold < folds and np.any(size[:2] + SLOT_GAP_M > hi - lo):
-                continue  # cloth folds rather than overhang
-            slot = self.free_slot(obj, support, relation, stack=stack, size=size)
-            if slot is not None:
-                return slot, size
-        return None
-
-    def free_slot(
-        self, obj: WorldObject, support: WorldObject, relation: Relation, *, stack: bool = False, size: np.ndarray | None = None,
-    ) -> np.ndarray | None:
-        """Centre of the first slot on the support, in reading order, where the item's box (of ``size``,
-        default its own) meets no other box (``_obstacles``); with ``stack``, when the surface is full,
-        at a slot flush with its far edges (``_slots``), else on the next layer up (on the highest item
-        in the way, whichever support it rests on; in a closed-lid container only while it fits under
-        the lid). An item wider than the surface overhangs it, centred. None when there is no such slot."""
-        size = obj.size if size is None else size
-        lo, hi, z = self.support_surface(support, relation)
-        half = size[:2] / 2 + SLOT_GAP_M / 2
-        slots = _slots(lo, hi, half, flush=stack)
-        while True:
-            others = self._obstacles(obj, support, lo, hi, z, size[2])
-            free = slots
-            if others:
-                centers = np.array([o.center[:2] for o in others])
-                reach = half + np.array([o.size[:2] / 2 for o in others])
-                overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
-                free = slots[~overlap]
-            if len(free):
-                return np.array([free[0, 0], free[0, 1], z + size[2] / 2])
-            layer = [o.top for o in others if o.kind == "item"]
-            lidded = relation == "inside" and support.openable
-            if not stack or not layer or (lidded and max(layer) + size[2] > support.top):
-                return None
-            z = max(layer)
-
-    def _obstacles(
-        self, obj: WorldObject, support: WorldObject, lo: np.ndarray, hi: np.ndarray, z: float, height: float,
-    ) -> list[WorldObject]:
-        """Objects in the space an item of ``height`` would take on the surface (``lo``, ``hi``, ``z``):
-        items already there and anything else standing in it (a TV on the coffee table, a shelf
-        hung above a desk), but not the supports of ``support`` nor ``obj``, its load or the held item."""
-        lo3, hi3 = np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + height])
-        skip = {obj.name, support.name, self.robot.held} | {o.name for o in self.descendants(obj.name)}
-        skip |= {parent.name for parent, _ in self.ancestors(support.name)}
-        objs = [o for o in self.objects.values() if o.kind != "floor" and o.name not in skip]
-        if not objs:
-            return []
-        centers, halves = np.array([o.center for o in objs]), np.array([o.size for o in objs]) / 2
-        eps = 1e-5  # boxes that merely touch (a card under a barrel's band) do not overlap
-        meets = np.all(centers - halves < hi3 - eps, axis=1) & np.all(centers + halves > lo3 + eps, axis=1)
-        return [o for o, m in zip(objs, meets) if m]
-
-
-def _slots(lo: np.ndarray, hi: np.ndarray, half: np.ndarray, *, flush: bool) -> np.ndarray:
-    """(n, 2) slot centres on a surface from ``lo`` to ``hi`` for an item of half extents ``half``: a
-    grid from the near corner in reading order (rows follow y); with ``flush``, then the same grid
-    mirrored to each other corner, whose slots lie flush with the far edges where the first grid
-    leaves a strip narrower than the item (a lamp in one corner of a nightstand leaves the far end)."""
-    xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
-    grids = [(xs, ys)]
-    if flush:
-        fx, fy = lo[0] + hi[0] - xs[::-1], lo[1] + hi[1] - ys[::-1]
-        grids += [(fx, ys), (xs, fy), (fx, fy)]
-    out = []
-    for gx, gy in (np.meshgrid(a, b) for a, b in grids):
-        out.append(np.stack([gx.ravel(), gy.ravel()], axis=1))
-    return np.concatenate(out)
-
-
-def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:
-    """Slot centres along one axis of a surface from ``lo`` to ``hi`` for an item of half-width ``half``;
-    the surface's centre alone when the item is wider."""
-    centres = np.arange(lo + half, hi - half + 1e-9, 2 * half)
-    return centres if len(centres) else np.array([(lo + hi) / 2])
-
-
-def _top_level(support: WorldObject) -> float:
-    """Height items rest at on top of ``support``: its top, or for a levelled support taller than the
-    arm reaches (``LEVELLED_CATEGORIES``) its highest inner level at most ``REACH_TOP_M`` high. Inner
-    levels lie ``LEVEL_STEP_M`` apart from the bottom slab up, a step or more below the top; a
-    support with none within reach (a single board hung high) keeps its top."""
-    if support.category not in LEVELLED_CATEGORIES or support.top <= REACH_TOP_M:
-        return support.top
-    first = support.bottom + SLAB_FRACTION * support.size[2]
-    highest = min(REACH_TOP_M, support.top - LEVEL_STEP_M)
-    if highest < first:
-        return support.top
-    return first + LEVEL_STEP_M * np.floor((highest - first) / LEVEL_STEP_M)
 
 
 def _alpha(i: int) -> str:

@@ -54,9 +54,9 @@ def scene_graph_png(graph: SceneGraph, *, title: str | None = None, dpi: int = 1
             f = np.array(region.frontiers)
             ax.scatter(f[:, 0], f[:, 1], marker="*", s=90, color=region_colour[rid], edgecolors="k", zorder=4)
     for obj in graph.objects.values():
-        lo, hi = obj.bbox.min, obj.bbox.max
+        low, high = obj.bbox.min, obj.bbox.max
         door = obj.category == "door"
-        ax.add_patch(plt.Rectangle((lo[0], lo[1]), hi[0] - lo[0], hi[1] - lo[1], fill=False,
+        ax.add_patch(plt.Rectangle((low[0], low[1]), high[0] - low[0], high[1] - low[1], fill=False,
                                    edgecolor="#ff00ff" if door else "#1f77b4", linewidth=1.5, zorder=4))
         ax.annotate(obj.label, (obj.position[0], obj.position[1]), fontsize=7, zorder=5)
     rx, ry = graph.robot.position

@@ -88,7 +88,8 @@ def limited_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> Episod
 def flaky_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
     """A retryable LLM error for tasks named 'flaky*' while ``FAKE_LLM_DOWN`` is set, else ``deterministic_episode``."""
     if spec.task.startswith("flaky") and os.environ.get("FAKE_LLM_DOWN"):
-        return EpisodeRecord.for_spec(spec, error="LLM error (LLMServerError): 500 on every attempt", retryable=True)
+        return EpisodeRecord.for_spec(spec, error="LLM error (LLMServerError): 500 on every attempt", error_kind="llm",
+                                     retryable=True)
     return deterministic_episode(spec, out_dir=out_dir)
 
 

@@ -85,7 +85,7 @@ class _Idle:
 def test_step_limit_ends_the_episode_with_the_reason() -> None:
     record = run_episode(SPEC.model_copy(update={"planner": "idle"}), planner=_Idle())
     assert record.high_level_steps == MAX_HIGH_LEVEL_STEPS and not record.done_called
-    assert record.error == f"step limit of {MAX_HIGH_LEVEL_STEPS} high-level steps reached"
+    assert record.termination == "step_limit" and record.error is None  # not a system error
 
 
 class _SolveThenLinger(OraclePlanner):
@@ -104,7 +104,8 @@ def test_acting_on_after_the_goal_holds_ends_after_five_steps_without_success() 
     assert record.all_goals_met and not record.success and not record.done_called
     waits = [a for a in record.actions if a.name == "wait"]
     assert len(waits) == STEPS_AFTER_GOAL + 1
-    assert "without done()" in (record.error or "")
+    assert record.termination == "steps_after_goal" and record.error is None
+    assert record.failure is not None and "without done()" in record.failure.detail
 
 
 class _Crashing(_Idle):
@@ -115,12 +116,14 @@ class _Crashing(_Idle):
 def test_a_raising_planner_is_recorded_with_its_traceback(tmp_path: Path) -> None:
     record = run_episode(SPEC.model_copy(update={"planner": "crash"}), planner=_Crashing(), out_dir=tmp_path)
     assert record.error == "RuntimeError: planner bug" and "Traceback" in (record.traceback or "")
+    assert record.error_kind == "crash" and record.termination is None
     assert (tmp_path / "episode.json").exists() and (tmp_path / "map.png").exists()
 
 
 def test_unknown_task_is_recorded_not_raised() -> None:
     record = run_episode(SPEC.model_copy(update={"task": "no_such_task"}))
     assert record.error is not None and "unknown task" in record.error and record.traceback is None
+    assert record.error_kind == "input"
 
 
 def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from more_agent.eval.failure import cause_counts, classify_failure
 from more_agent.eval.report import summary_markdown
-from more_agent.records import ActionRecord, EpisodeRecord, GoalCondition
+from more_agent.records import ActionRecord, EpisodeRecord, FailureReason, GoalCondition
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
@@ -31,8 +31,8 @@ def _record(**fields: object) -> EpisodeRecord:
     return EpisodeRecord(**{**base, **fields})
 
 
-def _act(name: str, target: str, ok: bool, feedback: str = "") -> ActionRecord:
-    return ActionRecord(step=0, name=name, arguments=["kitchen_0", target], ok=ok, feedback=feedback)
+def _act(name: str, target: str, ok: bool, feedback: str = "", reason: FailureReason | None = None) -> ActionRecord:
+    return ActionRecord(step=0, name=name, arguments=["kitchen_0", target], ok=ok, feedback=feedback, reason=reason)
 
 
 def test_each_cause_from_the_trace(world: World) -> None:
@@ -41,8 +41,8 @@ def test_each_cause_from_the_trace(world: World) -> None:
         return None if failure is None else failure.cause
 
     assert cause(_record(success=True, all_goals_met=True, done_called=True)) is None
-    assert cause(_record(error="LLM error (LLMTimeout): slow")) == "llm_error"
-    assert cause(_record(error="ValueError: x", traceback="...")) == "other"
+    assert cause(_record(error="LLM error (LLMTimeout): slow", error_kind="llm")) == "llm_error"
+    assert cause(_record(error="ValueError: x", error_kind="crash", traceback="...")) == "other"
     assert cause(_record(all_goals_met=True)) == "done_not_called"
     assert cause(_record(observed_objects=["bottom_cabinet_0"])) == "never_observed"
     assert cause(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)])) == "wrong_instance"
@@ -50,13 +50,31 @@ def test_each_cause_from_the_trace(world: World) -> None:
     both = _record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)], done_called=True)
     both.goal_conditions.append(other_goal)
     assert cause(both) == "done_early"  # bottom_cabinet B is a goal object too: not a wrong instance
-    assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "cannot reach canned_food A: no path on the map")])) == "unreachable"
-    assert cause(_record(actions=[_act("go_to_and_grasp", "canned_food A", False, "hand is full; holding apple A")])) == "subpolicy_failure"
-    assert cause(_record(actions=[ActionRecord(step=i, name="invalid", ok=False) for i in range(3)])) == "invalid_llm_answers"
-    assert cause(_record(done_called=True)) == "done_early"
-    assert cause(_record(high_level_steps=50)) == "step_limit"
+    unreachable = _act("go_to_and_grasp", "canned_food A", False, "no path", FailureReason.NOT_REACHABLE)
+    assert cause(_record(actions=[unreachable])) == "unreachable"
+    blocked = _act("go_to_and_grasp", "canned_food A", False, "blocked", FailureReason.PATH_BLOCKED_BY_DOOR)
+    assert cause(_record(actions=[blocked])) == "unreachable"
+    hand_full = _act("go_to_and_grasp", "canned_food A", False, "hand is full; holding apple A", FailureReason.HAND_FULL)
+    assert cause(_record(actions=[hand_full])) == "subpolicy_failure"
+    invalid = [ActionRecord(step=i, name="invalid", ok=False, reason=FailureReason.INVALID_ANSWER) for i in range(3)]
+    assert cause(_record(actions=invalid)) == "invalid_llm_answers"
+    assert cause(_record(done_called=True, termination="done")) == "done_early"
+    assert cause(_record(high_level_steps=50, termination="step_limit")) == "step_limit"
     detail = classify_failure(_record(observed_objects=["bottom_cabinet_0"]), world)
     assert detail is not None and detail.detail == "never observed canned_food A"  # labels, as the robot knows them
+
+
+def test_causes_read_types_not_text(world: World) -> None:
+    """Feedback and error text that reads like another cause changes nothing: only the typed fields count."""
+    worded = _act("go_to_and_grasp", "canned_food A", False, "cannot reach canned_food A: no path on the map",
+                  FailureReason.HAND_FULL)
+    assert classify_failure(_record(actions=[worded]), world).cause == "subpolicy_failure"  # type: ignore[union-attr]
+    named_invalid = [ActionRecord(step=i, name="invalid", ok=False) for i in range(3)]
+    assert classify_failure(_record(actions=named_invalid), world).cause != "invalid_llm_answers"  # type: ignore[union-attr]
+    ended = classify_failure(_record(high_level_steps=50, termination="step_limit"), world)
+    assert ended is not None and ended.detail.startswith("step limit of 50 high-level steps reached; ")
+    gave_up = classify_failure(_record(done_called=True, termination="done", gave_up="nothing fits"), world)
+    assert gave_up is not None and (gave_up.cause, gave_up.detail) == ("done_early", "nothing fits")
 
 
 def test_summary_counts_causes_per_system(world: World) -> None:

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from more_agent.eval.episode_folder import VIEWER_FILE
 from more_agent.eval.report import SourcedRecord
 from more_agent.eval.report_writer import write_reports
 from more_agent.eval.store import EPISODE_DIRS, EpisodeWriter, episode_dirname
-from more_agent.eval.episode_folder import VIEWER_FILE
 from tests.eval.chromium import Chromium, chromium_or_skip
 from tests.eval.conftest import EVIL, Episode
 

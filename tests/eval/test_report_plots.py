@@ -17,17 +17,15 @@ def rec(task: str, planner: str, **kw: object) -> EpisodeRecord:
 def test_failure_reason_prefers_the_classified_cause_then_the_error() -> None:
     assert failure_reason(rec("t", "more", success=True)) is None
     assert failure_reason(rec("t", "more", failure=Failure(cause="never_observed"), error="x: y")) == "never_observed"
-    assert failure_reason(rec("t", "more", error="step limit of 50 high-level steps reached")) == (
-        "step limit of N high-level steps reached"
-    )
-    assert failure_reason(rec("t", "more", error="LLM error (LLMTimeout): read timed out")) == "LLM error"
+    assert failure_reason(rec("t", "more", termination="step_limit")) == "step_limit"
+    assert failure_reason(rec("t", "more", error="LLM error (LLMTimeout): read timed out", error_kind="llm")) == "llm error"
     assert failure_reason(rec("t", "more")) == "unclassified"
 
 
 def test_write_plots_draws_every_plot_even_with_missing_cells(tmp_path: Path) -> None:
     records = [
         rec("t1", "oracle", success=True, all_goals_met=True, task_progress=1.0, high_level_steps=7),
-        rec("t2", "oracle", error="oracle gave up: grasp failed 2 times", high_level_steps=3),
+        rec("t2", "oracle", gave_up="oracle gave up: grasp failed 2 times", termination="done", high_level_steps=3),
         rec("t1", "more", failure=Failure(cause="step_limit"), high_level_steps=50,
             llm_usage=LLMUsage(calls=3, prompt_tokens=900, completion_tokens=60)),
     ]  # 'more' never ran t2: a blank cell in the heat map

@@ -138,7 +138,7 @@ def test_run_folder_lock_refuses_a_second_writer_and_dies_with_its_holder(tmp_pa
 
 
 def test_retire_retryable_moves_them_aside(tmp_path: Path) -> None:
-    records = [rec("a"), rec("b").model_copy(update={"error": "LLM error", "retryable": True}), rec("c")]
+    records = [rec("a"), rec("b").model_copy(update={"error": "LLM error", "error_kind": "llm", "retryable": True}), rec("c")]
     write(tmp_path / "episodes.jsonl", records)
     kept = retire_retryable(tmp_path, read_records(tmp_path))
     assert [r.task for r in kept] == ["a", "c"] == [r.task for r in read_records(tmp_path)]

@@ -115,7 +115,7 @@ def test_an_episode_folder_with_only_its_record_still_opens(tmp_path: Path) -> N
 
     record = EpisodeRecord(task="t", scene="s", seed=0, planner="oracle", trajectory=[(0.0, 0.0), (1.0, 1.0)],
                            actions=[ActionRecord(step=0, name="navigate", arguments=["x"], ok=False, feedback=EVIL)],
-                           high_level_steps=1, error="step limit of 50 high-level steps reached")
+                           high_level_steps=1, termination="step_limit")
     (tmp_path / "episode.json").write_text(record.model_dump_json())
     step = viewer_data(tmp_path)["steps"][0]
     assert step["action"]["feedback"] == EVIL and step["map"] is None and step["frames"] == [] and step["goals"] is None

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import pytest
 
+from more_agent.errors import UserError
 from more_agent.llm import (
     InvalidAnswer,
     LLMConfig,
@@ -20,7 +21,6 @@ from more_agent.llm import (
     render_prompt,
     room_messages,
 )
-from more_agent.errors import UserError
 from more_agent.llm.prompts import PROMPT_NAMES, check_history, prompt_fields
 from more_agent.skills import SKILLS
 from tests.fakes.openai_server import FakeOpenAIServer

@@ -35,7 +35,7 @@ def _check_invariants(graph: NavGraph, threshold: float) -> None:
         nbrs.setdefault(a, []).append((b, w))
         nbrs.setdefault(b, []).append((a, w))
     adjacent = {tuple(sorted(e)) for e in sparse.edges.tolist()}
-    for x, lst in nbrs.items():
+    for lst in nbrs.values():
         if len(lst) == 2:
             (u, w1), (v, w2) = lst
             assert w1 + w2 >= threshold or tuple(sorted((u, v))) in adjacent

@@ -17,9 +17,9 @@ from more_agent.eval.episode_folder import STEPS_FILE, VLM_IMAGES_DIR
 from more_agent.llm import CacheMode, LLMConfig, make_client
 from more_agent.llm.images import LOW_DETAIL_TOKENS
 from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
-from more_agent.planners.llm_planner import INVALID
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.skills import INVALID
 from tests.fakes.openai_server import request_images, request_text
 from tests.planners.brain import BrainServer
 from tests.planners.test_llm_episode import GOAL, KITCHEN, TASK

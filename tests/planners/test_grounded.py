@@ -9,7 +9,14 @@ import pytest
 from more_agent.eval.episode import run_episode
 from more_agent.planners.base import EpisodeContext, HighLevelAction, default_planner, make_planner
 from more_agent.planners.grounded import (
-    FLOOR, FRUITLESS_EXPLORES, GROUND_M, OPENS_BEFORE_EXPLORING, GroundedPlanner, _on_floor, _Step, far_frontiers,
+    FLOOR,
+    FRUITLESS_EXPLORES,
+    GROUND_M,
+    OPENS_BEFORE_EXPLORING,
+    GroundedPlanner,
+    _on_floor,
+    _Step,
+    far_frontiers,
 )
 from more_agent.planners.room_types import is_furniture, likely_room_type
 from more_agent.planners.task_goal import intended_goal, task_goal

@@ -13,9 +13,10 @@ import pytest
 from more_agent.eval.episode import run_episode
 from more_agent.eval.episode_folder import STEPS_FILE
 from more_agent.llm import CacheMode, LLMConfig, make_client
-from more_agent.planners.llm_planner import INVALID, PLANNER_CONFIGS, LLMClients, LLMPlanner
+from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.sim.instantiate import instantiate
+from more_agent.skills import INVALID
 from tests.fakes.openai_server import Close, Delay, Status
 from tests.planners.brain import BrainServer, RearrangeBrain, plan
 

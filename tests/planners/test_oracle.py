@@ -8,7 +8,8 @@ from types import SimpleNamespace
 from bddl.activity import Conditions
 
 from more_agent.planners.base import EpisodeContext, make_planner
-from more_agent.planners.oracle import OraclePlanner, merge_placements, order_literals
+from more_agent.planners.goal_order import order_literals
+from more_agent.planners.oracle import OraclePlanner, merge_placements
 from more_agent.sim.bddl_backend import ScopeObject
 from more_agent.sim.goals import GoalChecker, Literal
 from more_agent.sim.predicates import ROBOT_NAME

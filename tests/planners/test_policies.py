@@ -9,7 +9,15 @@ import numpy as np
 import pytest
 
 from more_agent.mapping import FREE, OCCUPIED
-from more_agent.planners.policies import Embodiment, agent_nav_grid, explore, go_to_and, navigate, path_to_nearest, pick_target
+from more_agent.planners.policies import (
+    Embodiment,
+    agent_nav_grid,
+    explore,
+    go_to_and,
+    navigate,
+    path_to_nearest,
+    pick_target,
+)
 from more_agent.planners.policies.skills import place_on_floor
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim.actions import FailureReason

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
-from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
+from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Embodiment, go_to_and
 from more_agent.sim import catalog
 from more_agent.sim.instantiate import free_floor_spot, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World, WorldObject
+from more_agent.vocabulary import FLOOR
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 

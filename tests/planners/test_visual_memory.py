@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 from more_agent.llm.errors import InvalidAnswer
-from more_agent.planners.visual_memory import MemoryConfig, VisualMemory, covering_frames, memory_frame, shows_points, spread
+from more_agent.planners.visual_memory import (
+    MemoryConfig,
+    VisualMemory,
+    covering_frames,
+    memory_frame,
+    shows_points,
+    spread,
+)
 from more_agent.planners.vlm_prompts import parse_choice, parse_step, parse_verdict
 from more_agent.sim.camera import Camera
 from more_agent.sim.render import Frame

@@ -13,7 +13,6 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
-
 _ENTRY = re.compile(r"([A-Za-z_]+ [A-Z]+)(?: \[([^\]]*)\])?")
 
 

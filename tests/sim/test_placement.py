@@ -11,10 +11,11 @@ from pathlib import Path
 import numpy as np
 
 from more_agent.sim.instantiate import instantiate
+from more_agent.sim.packing import LEVELLED_CATEGORIES, REACH_TOP_M, support_surface
 from more_agent.sim.placement_audit import audit, enclosing_object
 from more_agent.sim.predicates import is_inside, is_ontop
 from more_agent.sim.scene import load_scene
-from more_agent.sim.world import LEVELLED_CATEGORIES, REACH_TOP_M, World, WorldObject
+from more_agent.sim.world import World, WorldObject
 
 TINY = Path(__file__).parent.parent / "fixtures" / "tiny_scene.json"
 
@@ -109,7 +110,7 @@ def test_a_garment_folds_into_a_washer_where_a_rigid_box_of_its_size_does_not() 
         _add(world, f"jersey_{k}", "jersey", "item", (5.0, 5.0, 0.0), size, cloth=True)
         assert world.place_if_room(f"jersey_{k}", washer.name, "inside", stack=True)
         jersey = world.objects[f"jersey_{k}"]
-        lo, hi, _ = world.support_surface(washer, "inside")
+        lo, hi, _ = support_surface(washer, "inside")
         assert np.all(jersey.box()[0][:2] >= lo - 1e-9) and np.all(jersey.box()[1][:2] <= hi + 1e-9)  # no overhang
         assert jersey.top <= washer.top and enclosing_object(world, f"jersey_{k}") is None
         assert jersey.size[0] * jersey.size[1] < size[0] * size[1]  # folded

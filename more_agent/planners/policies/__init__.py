@@ -5,7 +5,14 @@ skill table (``skills``)."""
 from more_agent.planners.policies.embodiment import Embodiment, PolicyConfig
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
 from more_agent.planners.policies.skills import (
-    SUBPOLICIES, Area, explore, explore_frontiers, go_to_and, navigate, pick_target, run_skill,
+    SUBPOLICIES,
+    Area,
+    explore,
+    explore_frontiers,
+    go_to_and,
+    navigate,
+    pick_target,
+    run_skill,
 )
 
 __all__ = [

@@ -14,19 +14,24 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Any, Literal
+from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
+from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
 from more_agent.sim.camera import Camera
 from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
 from more_agent.sim.motion import full_turn_angles
-from more_agent.sim.navgrid import DEFAULT_NAV, XY
+from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.world import World
+from more_agent.vocabulary import Relation
+
+PLAN_MARGIN_M = 0.05
+"""Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
 
 
 class PolicyConfig(BaseModel):
@@ -35,7 +40,8 @@ class PolicyConfig(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     plan_inflation_m: float = Field(
-        default=0.25, gt=0, description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin)."
+        default=ROBOT.radius_m + PLAN_MARGIN_M, gt=0,
+        description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin)."
     )
     sense_every_steps: int = Field(default=4, ge=1, description="Fuse a frame after this many forward moves on a path.")
     max_replans: int = Field(default=3, ge=0, description="Replans on the updated map after a blocked move before giving up.")
@@ -130,7 +136,7 @@ class Embodiment:
         return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
                             path=path, blocking=result.blocking)
 
-    def _rests(self, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
+    def _rests(self, name: str) -> tuple[Relation, str | None] | None:
         """How a seen object rests, as perception reports it: the world's support link (what the last
         placement did), the support named by its label (None for a floor); None while held."""
         obj = self.world.get(name)
@@ -197,7 +203,7 @@ class Embodiment:
                 ok = self._step("move_forward", amount=distance)["action_ok"]
                 self.low_level_steps += 1
                 if not ok:
-                    reach = FORWARD_STEP_M + DEFAULT_NAV.robot_radius_m
+                    reach = FORWARD_STEP_M + ROBOT.radius_m
                     yaw = self.world.robot.yaw
                     self.bumps.append((self.xy[0] + reach * math.cos(yaw), self.xy[1] + reach * math.sin(yaw)))
                     self.sense()

@@ -18,15 +18,14 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from more_agent.planners.policies.embodiment import Embodiment
+from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim import actions
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY, PathResult
 from more_agent.sim.world import floor_name
 from more_agent.skills import Skill, Subpolicy, skill_named
-
-from more_agent.planners.policies.embodiment import Embodiment
-from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
 
 
 def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
