@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from pydantic import ValidationError
@@ -27,7 +27,7 @@ MAX_COUNT = 10**12
 MAX_COST_USD = 1e9
 """Largest cost a record may hold."""
 
-MIGRATIONS: dict[int, Callable[[dict[str, Any]], dict[str, Any]]] = UPGRADES
+MIGRATIONS: Mapping[int, Callable[[dict[str, Any]], dict[str, Any]]] = UPGRADES
 """Older schema version -> function that turns such a record into the next version's form. A version
 missing here is refused with a message (no migration for schema 1 exists: its records predate this
 repository's first release)."""

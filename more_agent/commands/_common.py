@@ -23,7 +23,7 @@ import sys
 import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Annotated, TextIO, TypeVar
+from typing import Annotated, NoReturn, TextIO, TypeVar
 
 import typer
 from rich.console import Console
@@ -148,21 +148,21 @@ def user_errors_exit_2(fn: F) -> F:
             try:
                 result = fn(*args, **kwargs)
             except KeyboardInterrupt:
-                return _interrupted()
+                _interrupted()
             except (UserError, OSError, RecursionError) as e:
                 if interrupted():
-                    return _interrupted()
+                    _interrupted()
                 code, message = error_exit_status(e)
                 print_error(message)
                 raise typer.Exit(code=code) from None
             if interrupted():
-                return _interrupted()
+                _interrupted()
         return result
 
     return wrapper  # type: ignore[return-value]
 
 
-def _interrupted() -> None:
+def _interrupted() -> NoReturn:
     err_console.print("interrupted", style="yellow", highlight=False)
     raise typer.Exit(code=signal_exit_status())
 

@@ -62,11 +62,11 @@ def to_spark_dsg(graph: SceneGraph) -> Any:
     categories = sorted({o.category for o in graph.objects.values()})
     G.set_labelspace(dsg.Labelspace(dict(enumerate(categories))), OBJECTS)
     places = [dsg.NodeSymbol("p", i) for i in range(len(graph.nav.node_xy))]
-    for sym, xy, region in zip(places, graph.nav.node_xy.tolist(), graph.nav.node_region):
+    for sym, xy, place_region in zip(places, graph.nav.node_xy.tolist(), graph.nav.node_region):
         attrs = dsg.PlaceNodeAttributes()
         attrs.position = np.array([xy[0], xy[1], 0.0])
         attrs.real_place = True
-        attrs.metadata.set({KEY: {"region": region}})
+        attrs.metadata.set({KEY: {"region": place_region}})
         G.add_node(PLACES, sym, attrs)
     for k, ((a, b), w, door) in enumerate(zip(graph.nav.edges.tolist(), graph.nav.weights.tolist(),
                                               graph.nav.door_edges.tolist())):
@@ -160,7 +160,7 @@ def _meta(attrs: Any) -> dict[str, Any]:
 def _labelspace(G: Any, layer: int, name: str) -> dict[int, str]:
     """The layer's label space from the graph's metadata (as spark-dsg saves it, by layer name or key)."""
     spaces = G.metadata.get().get("labelspaces") or {}
-    pairs = next((spaces[k] for k in (name, f"_l{layer}p0", str(layer)) if k in spaces), [])
+    pairs: Any = next((spaces[k] for k in (name, f"_l{layer}p0", str(layer)) if k in spaces), [])
     return {int(k): str(v) for k, v in (pairs.items() if isinstance(pairs, dict) else pairs)}
 
 
@@ -227,7 +227,8 @@ def _regions(G: Any, real: list[Any], xy: np.ndarray, edges: np.ndarray,
             node_region[i] = f"region_{len(rooms) + k}"
     members: dict[str, list[int]] = {rid: [] for rid in names.values()}
     for i, rid in enumerate(node_region):
-        members.setdefault(rid, []).append(i)  # type: ignore[arg-type] - every place has a region by now
+        assert rid is not None  # every place has a region by now
+        members.setdefault(rid, []).append(i)
     room_of = {rid: rooms[v] for v, rid in names.items()}
     regions = {}
     for rid in sorted(members):

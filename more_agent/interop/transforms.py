@@ -8,6 +8,7 @@ import bisect
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation, Slerp
 
 from more_agent.interop.bag_contract import BagError
@@ -16,7 +17,7 @@ MAX_GAP_S = 0.1
 """How far (seconds) a lookup may lie before the first or after the last sample of a transform."""
 
 
-def pose_matrix(translation: np.ndarray, quaternion_xyzw: np.ndarray) -> np.ndarray:
+def pose_matrix(translation: ArrayLike, quaternion_xyzw: ArrayLike) -> np.ndarray:
     """4x4 homogeneous transform of a translation and a unit quaternion (x, y, z, w, as ROS writes it)."""
     T = np.eye(4)
     T[:3, :3] = Rotation.from_quat(quaternion_xyzw).as_matrix()
@@ -45,7 +46,7 @@ class TransformBuffer:
         self.max_gap_s = max_gap_s
         self._edges: dict[str, _Edge] = {}
 
-    def add(self, parent: str, child: str, stamp_s: float, translation: np.ndarray, quaternion_xyzw: np.ndarray,
+    def add(self, parent: str, child: str, stamp_s: float, translation: ArrayLike, quaternion_xyzw: ArrayLike,
             *, static: bool = False) -> None:
         """One sample of the pose of ``child`` in ``parent`` (a frame has one parent, as in tf2)."""
         edge = self._edges.setdefault(child, _Edge(parent=parent, static=static))
@@ -63,7 +64,8 @@ class TransformBuffer:
     def lookup(self, target: str, source: str, stamp_s: float) -> np.ndarray:
         """T_target_source at ``stamp_s``: the chain from ``source`` up to ``target``."""
         T = np.eye(4)
-        frame, seen = source, []
+        frame = source
+        seen: list[str] = []
         while frame != target:
             edge = self._edges.get(frame)
             if edge is None:

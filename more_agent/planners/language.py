@@ -210,6 +210,6 @@ def _merge(entries: Iterable[_Entry]) -> tuple[ObjectText, ...]:
     for name, oid, state, relation, held in entries:
         groups.setdefault((name, state or "", relation or (), held), []).append(oid)
     return tuple(
-        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None, held=h)  # type: ignore[arg-type]
+        ObjectText(name=n, ids=tuple(ids), state=s or None, relation=r or None, held=h)
         for (n, s, r, h), ids in sorted(groups.items())
     )
