@@ -9,6 +9,7 @@ but some episodes hit transient errors (LLM transport, worker deaths): re-run th
 from __future__ import annotations
 
 import functools
+import json
 import logging
 import sys
 from collections.abc import Callable
@@ -21,7 +22,6 @@ from rich.text import Text
 
 from more_agent.errors import UserError, check_writable_dir
 from more_agent.interrupts import interrupted, sigint_remembered
-from more_agent.llm.limits import MAX_LOG_CHARS, clip
 from more_agent.redaction import redact
 
 console = Console()
@@ -45,11 +45,22 @@ DistractorsOption = Annotated[bool, typer.Option(
 )]
 """``--distractors/--no-distractors`` of ``run`` and ``eval``."""
 
+JsonOption = Annotated[bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")]
+"""``--json`` of the listing commands and ``report``."""
+
+
+def print_json(value: object) -> None:
+    """``value`` as indented JSON on stdout (plain text: never read as rich markup)."""
+    typer.echo(json.dumps(value, indent=2, ensure_ascii=False))
+
 
 class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""
 
     def emit(self, record: logging.LogRecord) -> None:
+        # imported here: the llm package is slow to import, and most commands never log
+        from more_agent.llm.limits import MAX_LOG_CHARS, clip
+
         try:
             sys.stderr.write(f"{record.levelname.lower()}: {clip(redact(record.getMessage()), MAX_LOG_CHARS)}\n")
         except Exception:  # noqa: BLE001 - logging must never take the program down
