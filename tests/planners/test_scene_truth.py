@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from more_agent.planners.language import FLOOR, LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Embodiment, go_to_and
@@ -106,6 +107,7 @@ def _shuffle(world: World, rng: np.random.Generator, check: bool = True) -> tupl
     return placements, closed
 
 
+@pytest.mark.slow
 def test_scene_text_follows_many_random_placements_opens_and_closes() -> None:
     for seed in range(3):
         placements, closed = _shuffle(_world(seed), np.random.default_rng(100 + seed))

@@ -51,6 +51,7 @@ def _check_floor_items_clear(inst: TaskInstance) -> None:
                 assert np.any(gap >= 0), f"{inst.task}: {item.name} overlaps {f.name}"
 
 
+@pytest.mark.slow
 def test_every_paper_task_instantiates_or_fails_explicitly() -> None:
     failures = {}
     for task in task_set("more-paper"):
