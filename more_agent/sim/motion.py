@@ -24,7 +24,6 @@ from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
 from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
-
 _TOLERANCE = 1e-6
 """Requests this close to the maximum (float32 actions) count as the maximum, not as clipped."""
 
