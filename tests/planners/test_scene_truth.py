@@ -114,6 +114,7 @@ def test_scene_text_follows_many_random_placements_opens_and_closes() -> None:
         assert placements >= 5 and closed  # the random draws did exercise placing and closing
 
 
+@pytest.mark.slow
 def test_observed_items_are_reached_from_a_random_start() -> None:
     """From this start the Voronoi node nearest hardback A lay beyond a gap narrower than the robot's
     clearance ("no path on the map"); the item itself was within arm's reach of the robot's part of the map."""

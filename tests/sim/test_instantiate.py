@@ -133,6 +133,7 @@ print(hashlib.sha256(repr(state).encode()).hexdigest())
 """
 
 
+@pytest.mark.slow
 def test_instantiation_is_the_same_under_every_string_hash_seed() -> None:
     """Two cabinets fit the task's cabinet scope: which one it binds must not follow Python's set order."""
     import os
