@@ -125,7 +125,8 @@ class World:
     version: int = 0
     layout_version: int = 0
     """Increases on every change of an object (pose, support, open state); unlike ``version``, not
-    when the robot merely moves, so renderers rebuild their geometry only when it changed."""
+    when the robot merely moves, so renderers rebuild their geometry only when it changed. Carrying an
+    item moves it but counts only when something rests in or on it: a held item is never drawn."""
     _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
     """Category -> how many instance labels of it have been handed out."""
 
@@ -323,7 +324,7 @@ class World:
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
         self.version += 1
-        if self.robot.held is not None:  # the held item moved along
+        if self.robot.held is not None and self.children(self.robot.held):  # what rests in / on it moved along
             self.layout_version += 1
 
     def _carry(self) -> None:
