@@ -18,6 +18,7 @@ for what a command raised.
 from __future__ import annotations
 
 import functools
+import json
 import logging
 import sys
 import warnings
@@ -76,11 +77,21 @@ HistoryOption = Annotated[str, typer.Option(
 )]
 """``--history`` of ``run`` and ``eval``."""
 
+JsonOption = Annotated[bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")]
+"""``--json`` of the listing commands and ``report``."""
+
+
+def print_json(value: object) -> None:
+    """``value`` as indented JSON on stdout (plain text: never read as rich markup)."""
+    typer.echo(json.dumps(value, indent=2, ensure_ascii=False))
+
 
 class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""
 
     def emit(self, record: logging.LogRecord) -> None:
+        # imported here: the llm package is slow to import, and most commands never log
+
         try:
             sys.stderr.write(f"{record.levelname.lower()}: {clip(for_terminal(record.getMessage()), MAX_LOG_CHARS)}\n")
         except Exception:  # noqa: BLE001 - logging must never take the program down

@@ -4,12 +4,23 @@ from __future__ import annotations
 
 from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.markup import escape
 from rich.table import Table
 
-from more_agent.commands._common import MAX_SEED, check_output_file, console, user_errors_exit_2
+from more_agent.commands._common import (
+    MAX_SEED,
+    JsonOption,
+    check_output_file,
+    console,
+    print_json,
+    user_errors_exit_2,
+)
+
+if TYPE_CHECKING:
+    from more_agent.sim.scene import Scene
 
 app = typer.Typer(help="BEHAVIOR-1K scenes: list, show, generate, render.", no_args_is_help=True)
 
@@ -19,10 +30,13 @@ SEED_OPT = typer.Option(0, "--seed", min=0, max=MAX_SEED, help="Layout seed; sam
 
 @app.command("list")
 @user_errors_exit_2
-def list_() -> None:
+def list_(as_json: JsonOption = False) -> None:
     """List the 51 BEHAVIOR-1K scenes with their rooms."""
     from more_agent.sim import catalog
 
+    if as_json:
+        print_json([{"scene": name, "rooms": list(catalog.scene_rooms(name))} for name in catalog.scene_names()])
+        return
     table = Table("scene", "rooms", "room ids")
     for name in catalog.scene_names():
         rooms = list(catalog.scene_rooms(name))
@@ -32,11 +46,14 @@ def list_() -> None:
 
 @app.command("show")
 @user_errors_exit_2
-def show(scene: str = SCENE_ARG, seed: int = SEED_OPT) -> None:
+def show(scene: str = SCENE_ARG, seed: int = SEED_OPT, as_json: JsonOption = False) -> None:
     """Rooms (type, area, ground, doors), doors and furniture counts of a generated plan."""
     from more_agent.sim.scenes import get_scene
 
     s = get_scene(scene, seed)
+    if as_json:
+        print_json(_show_json(s))
+        return
     console.print(f"[bold]{escape(s.name)}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
                   f"{len(s.windows)} windows, {len(s.furniture)} furniture, {len(s.walls)} wall boxes")
     rooms = Table("room", "type", "area m²", "ground", "outdoor", "doors to", "furniture")
@@ -49,6 +66,21 @@ def show(scene: str = SCENE_ARG, seed: int = SEED_OPT) -> None:
                  ", ".join(links), ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())))
         rooms.add_row(*map(escape, cells))  # a hand-written scene file may hold any text
     console.print(rooms)
+
+
+def _show_json(s: Scene) -> dict[str, object]:
+    """What ``scene show --json`` prints (keys in docs/cli-json.md)."""
+    rooms = []
+    for r in s.rooms:
+        counts = Counter(f.category for f in s.furniture if f.room == r.id)
+        rooms.append({
+            "id": r.id, "type": r.type, "area_m2": round((r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1]), 3),
+            "ground": r.ground, "outdoor": r.outdoor,
+            "doors": [{"door": d.id, "to": next(x for x in d.rooms if x != r.id), "open": d.open} for d in s.doors if r.id in d.rooms],
+            "furniture": dict(sorted(counts.items())),
+        })
+    return {"scene": s.name, "seed": s.seed, "n_doors": len(s.doors), "n_windows": len(s.windows),
+            "n_furniture": len(s.furniture), "n_wall_boxes": len(s.walls), "rooms": rooms}
 
 
 @app.command("generate")

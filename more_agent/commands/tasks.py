@@ -8,7 +8,13 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from more_agent.commands._common import MAX_SEED, console, user_errors_exit_2
+from more_agent.commands._common import (
+    MAX_SEED,
+    JsonOption,
+    console,
+    print_json,
+    user_errors_exit_2,
+)
 
 app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.", no_args_is_help=True)
 
@@ -17,12 +23,17 @@ app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.",
 @user_errors_exit_2
 def list_(
     set_: Annotated[str | None, typer.Option("--set", help="Task set: 'more-paper' or 'behavior-rearrange'.")] = None,
+    as_json: JsonOption = False,
 ) -> None:
     """List tasks (all 1016 activities, or one task set) with objects, goal literals, status and scenes."""
-    from more_agent.sim.tasks import task_data, task_names, task_set
+    from more_agent.sim.tasks import task_data, task_set
 
-    names = task_set(set_) if set_ is not None else task_names()
     data = task_data()["tasks"]
+    names = task_set(set_) if set_ is not None else sorted(data)  # the package data holds every activity
+    if as_json:
+        print_json([{"task": name, "n_objects": data[name]["n_objects"], "n_goal_literals": data[name]["n_goal_literals"],
+                     "instantiable": data[name]["instantiable"], "scenes": data[name]["scenes"]} for name in names])
+        return
     table = Table(title=f"{len(names)} tasks" + (f" in {set_}" if set_ else ""))
     table.add_column("task", no_wrap=True)
     for col in ("objects", "goal literals", "instantiable", "scenes"):
@@ -41,6 +52,7 @@ def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
     scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: drawn with the seed).")] = None,
     seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation and instantiation.")] = 0,
+    as_json: JsonOption = False,
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
     from more_agent.sim.instantiate import instantiate
@@ -53,6 +65,9 @@ def show(
         suitable_scenes,
     )
 
+    if as_json:
+        print_json(_show_json(task, scene, seed))
+        return
     definition = load_task(task)
     scenes = suitable_scenes(task)
     console.print(task, style="bold", highlight=False, markup=False)
@@ -81,3 +96,35 @@ def show(
     console.print(table)
     if inst.unsupported_literals:
         console.print("init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False)
+
+
+def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
+    """What ``tasks show --json`` prints (keys in docs/cli-json.md)."""
+    from more_agent.sim.instantiate import instantiate
+    from more_agent.sim.tasks import (
+        check_scene_suits,
+        draw_scenes,
+        literal_text,
+        load_task,
+        suitable_scenes,
+    )
+
+    definition = load_task(task)
+    scenes, drawn = suitable_scenes(task), draw_scenes(task, seed)
+    if scene is not None:
+        check_scene_suits(task, scene)
+    out: dict[str, object] = {
+        "task": task, "suitable_scenes": scenes, "episode_scenes": drawn, "seed": seed,
+        "goal": [literal_text(lit) for lit in definition.goal], "instance": None,
+    }
+    if scenes or scene is not None:
+        inst = instantiate(task, scene, seed)
+        objects = []
+        for s, name in inst.scope.items():
+            obj = inst.world.objects.get(name)
+            objects.append({"scope": s, "object": name, "label": inst.label(s), "category": obj.category if obj else None,
+                            "relation": obj.relation if obj else None, "parent": obj.parent if obj else None,
+                            "room": obj.room if obj else None})
+        out["instance"] = {"scene": inst.scene, "description": inst.description, "objects": objects,
+                           "unsupported_literals": list(inst.unsupported_literals)}
+    return out

@@ -12,6 +12,7 @@ door): a node behind a wall is not near the object however close it is.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
@@ -50,16 +51,60 @@ def line_of_sight(p: np.ndarray, targets: np.ndarray, blocked: np.ndarray, grid:
     ...               Grid(resolution_m=0.5))
     array([ True, False])
     """
-    length = np.linalg.norm(targets - p, axis=1).max(initial=0.0)
-    n = max(2, int(np.ceil(length / (grid.resolution_m / 2))) + 1)
-    s = np.linspace(0.0, 1.0, n)
-    pts = p + s[None, :, None] * (targets - p)[:, None, :]
-    cells = grid.cell_of(pts)
-    inside = (cells >= 0).all(-1) & (cells[..., 0] < blocked.shape[0]) & (cells[..., 1] < blocked.shape[1])
-    cells = np.where(inside[..., None], cells, 0)
-    hit = blocked[cells[..., 0], cells[..., 1]] & inside
-    started = np.logical_or.accumulate(~hit, axis=1)
-    return ~(hit & started).any(axis=1)
+    return lines_of_sight(np.asarray(p, dtype=float)[None], np.asarray(targets, dtype=float)[None], blocked, grid)[0]
+
+
+def lines_of_sight(points: np.ndarray, targets: np.ndarray, blocked: np.ndarray, grid: Grid) -> np.ndarray:
+    """:func:`line_of_sight` of many points at once: ``seen[j, t]`` for point j and its target t.
+
+    Parameters
+    ----------
+    points : ndarray, shape (m, 2)
+    targets : ndarray, shape (m, k, 2)
+        The targets of each point.
+    blocked, grid
+        As for :func:`line_of_sight`.
+
+    Returns
+    -------
+    seen : ndarray of bool, shape (m, k)
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+    targets = np.ascontiguousarray(targets, dtype=np.float64).reshape(len(points), -1, 2)
+    seen = np.empty(targets.shape[:2], dtype=np.bool_)
+    _sight(points, targets, np.ascontiguousarray(blocked, dtype=np.bool_), float(grid.origin_xy[0]),
+           float(grid.origin_xy[1]), float(grid.resolution_m), seen)
+    return seen
+
+
+@njit(cache=True)
+def _sight(points, targets, blocked, x0, y0, res, seen):  # pragma: no cover - compiled
+    """Each point's segments to its targets, sampled every half cell (n samples, the same for all
+    targets of a point, from the farthest; ``i / (n - 1)`` as ``np.linspace`` spaces them); a target is
+    seen unless a blocked cell follows an unblocked sample. ``Grid.cell_of`` is repeated inline."""
+    nx, ny = blocked.shape
+    for j in range(points.shape[0]):
+        px, py = points[j, 0], points[j, 1]
+        length = 0.0
+        for t in range(targets.shape[1]):
+            dx, dy = targets[j, t, 0] - px, targets[j, t, 1] - py
+            length = max(length, np.sqrt(dx * dx + dy * dy))
+        n = max(2, int(np.ceil(length / (res / 2))) + 1)
+        step = 1.0 / (n - 1)
+        for t in range(targets.shape[1]):
+            dx, dy = targets[j, t, 0] - px, targets[j, t, 1] - py
+            started, ok = False, True
+            for i in range(n):
+                s = 1.0 if i == n - 1 else i * step
+                cx = int(np.floor((px + s * dx - x0) / res))
+                cy = int(np.floor((py + s * dy - y0) / res))
+                if 0 <= cx < nx and 0 <= cy < ny and blocked[cx, cy]:
+                    if started:
+                        ok = False
+                        break
+                else:
+                    started = True
+            seen[j, t] = ok
 
 
 def assign_objects(
@@ -122,27 +167,32 @@ def assign_objects(
     tree = cKDTree(graph.xy[cand])
     kk = min(k, cand.size)
     adjacency = graph.csr(None if cut is None else ~cut)
-
-    def near(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        d, i = tree.query(p, k=kk)
-        d, i = np.atleast_1d(d), np.atleast_1d(i)
-        if blocked is not None and grid is not None:  # both or neither (checked above)
-            seen = line_of_sight(p, graph.xy[cand[i]], blocked, grid)
-            if seen.any():
-                d, i = d[seen], i[seen]
-        within = d <= max(radius_m, d[0])
-        return cand[i[within]], d[within]
-
-    for j, (obj, vp) in enumerate(zip(np.asarray(objects_xy, float), np.asarray(viewpoints_xy, float))):
-        s_o, d_o = near(obj)
-        s_vp, d_vp = near(vp)
-        common = np.intersect1d(labels[s_o], labels[s_vp])
-        if common.size == 0:
+    objects_xy, viewpoints_xy = np.asarray(objects_xy, float), np.asarray(viewpoints_xy, float)
+    near_o = _near_nodes(objects_xy, tree, cand, kk, graph, blocked, grid, radius_m)
+    near_vp = _near_nodes(viewpoints_xy, tree, cand, kk, graph, blocked, grid, radius_m)
+    for j, ((s_o, d_o), (s_vp, d_vp)) in enumerate(zip(near_o, near_vp)):
+        common = sorted(set(labels[s_o].tolist()) & set(labels[s_vp].tolist()))
+        if not common:
             out[j] = labels[s_o[0]]
-        elif common.size == 1:
+        elif len(common) == 1:
             out[j] = common[0]
         else:
             dv = csgraph.dijkstra(adjacency, directed=False, indices=s_vp)[:, s_o]  # (|S_vp|, |S_O|)
             cost = dv + d_o[None, :] ** lam + d_vp[:, None]
             out[j] = labels[s_o[np.unravel_index(np.argmin(cost), cost.shape)[1]]]
     return out
+
+
+def _near_nodes(points: np.ndarray, tree: cKDTree, cand: np.ndarray, kk: int, graph: NavGraph,
+                blocked: np.ndarray | None, grid: Grid | None, radius_m: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """S_p of Eq. 1 for each point: its ``kk`` nearest candidate nodes, those it sees if it sees any,
+    within ``radius_m`` (or the closest); as (node indices, distances), nearest first."""
+    d, i = tree.query(points, k=kk)
+    d, i = d.reshape(len(points), kk), i.reshape(len(points), kk)
+    keep = np.ones(d.shape, dtype=bool)
+    if blocked is not None:
+        seen = lines_of_sight(points, graph.xy[cand[i]], blocked, grid)
+        keep = seen | ~seen.any(axis=1, keepdims=True)
+    first = np.take_along_axis(d, np.argmax(keep, axis=1)[:, None], axis=1)
+    keep &= d <= np.maximum(radius_m, first)
+    return [(cand[i[j, keep[j]]], d[j, keep[j]]) for j in range(len(points))]

@@ -11,7 +11,6 @@ from collections.abc import Callable, Sequence
 from typing import TypeVar
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 L = TypeVar("L")
 R = TypeVar("R")
@@ -27,6 +26,9 @@ def maximum_matching(left: Sequence[L], right: Sequence[R], allowed: Callable[[L
     """
     if not left or not right:
         return {}
+    # imported here: scipy.optimize takes 0.7 s to import, and a listing never matches
+    from scipy.optimize import linear_sum_assignment
+
     cost = np.array([[0.0 if allowed(a, b) else 1.0 for b in right] for a in left])
     rows, cols = linear_sum_assignment(cost)
     return {left[i]: right[j] for i, j in zip(rows, cols) if cost[i, j] == 0.0}

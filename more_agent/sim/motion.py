@@ -13,6 +13,7 @@ reduces an existing overlap is allowed, so a robot put in a tight spot can alway
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 from enum import Enum
 
@@ -21,7 +22,7 @@ import numpy as np
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
 from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
 from more_agent.sim.outcome import Outcome
-from more_agent.sim.world import World
+from more_agent.sim.world import World, WorldObject
 
 _TOLERANCE = 1e-6
 """Requests this close to the maximum (float32 actions) count as the maximum, not as clipped."""
@@ -44,15 +45,34 @@ class MotionResult(Outcome[MotionFailure]):
 
 
 def obstacle_boxes(world: World, config: NavConfig = DEFAULT_NAV) -> np.ndarray:
-    """(N, 4) footprints (xmin, ymin, xmax, ymax) of everything the base collides with now."""
+    """(N, 4) footprints (xmin, ymin, xmax, ymax) of everything the base collides with now.
+
+    Walls and furniture never move during an episode (``WorldObject.movable``): their footprints are
+    gathered once per world and object count (``_fixed_obstacles``); only the doors' state is read on
+    every move. The rows are the fixed ones, then the closed doors.
+    """
+    fixed, doors = _fixed_obstacles(world, config)
+    closed = [d.footprint() for d in doors if not d.is_open]
+    return np.concatenate([fixed, np.asarray(closed, dtype=np.float64).reshape(-1, 4)]) if closed else fixed
+
+
+_FIXED: list[tuple[weakref.ref[World], int, NavConfig, np.ndarray, list[WorldObject]]] = []
+"""The last world's fixed footprints and doors (one entry: an episode drives one world at a time)."""
+
+
+def _fixed_obstacles(world: World, config: NavConfig) -> tuple[np.ndarray, list[WorldObject]]:
+    """Footprints of the walls and furniture that block the base, and the world's doors (cached)."""
+    if _FIXED:
+        ref, n_objects, cfg, fixed, doors = _FIXED[0]
+        if ref() is world and n_objects == len(world.objects) and cfg == config:
+            return fixed, doors
     rows = [w.bounds for w in world.scene.walls if w.z_min < config.obstacle_max_bottom_m]
-    for obj in world.objects.values():
-        blocks = (obj.kind == "door" and not obj.is_open) or (
-            obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m
-        )
-        if blocks:
-            rows.append(obj.footprint())
-    return np.asarray(rows, dtype=np.float64).reshape(-1, 4)
+    rows += [o.footprint() for o in world.objects.values()
+             if o.kind == "furniture" and o.bottom < config.obstacle_max_bottom_m]
+    fixed = np.asarray(rows, dtype=np.float64).reshape(-1, 4)
+    doors = [o for o in world.objects.values() if o.kind == "door"]
+    _FIXED[:] = [(weakref.ref(world), len(world.objects), config, fixed, doors)]
+    return fixed, doors
 
 
 def clearance(boxes: np.ndarray, x: float, y: float) -> float:

@@ -8,7 +8,7 @@ smaller than Fetch's ~0.28 m base) is chosen so that 0.9 m doors and 0.8 m corri
 
 Grids depend only on the world's fixed geometry and on which doors are closed, so they are cached
 per (world, closed doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
-simplified to polylines. ``blocking_door`` names the closed door on the way when a goal is only
+simplified to polylines (``simplify_polyline``, Douglas-Peucker). ``blocking_door`` names the closed door on the way when a goal is only
 reachable with doors open: the magic actions report it so that a planner knows what to open.
 
 Rasters are ``free[ix, iy]`` on a :class:`~more_agent.sim.grid.Grid`. The searches (nearest free
@@ -27,7 +27,6 @@ from functools import cached_property
 import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
-from skimage.measure import approximate_polygon
 
 from more_agent.robot_spec import ROBOT
 from more_agent.sim.grid import Grid
@@ -208,6 +207,42 @@ class PathResult:
 _NO_PATH = PathResult(goal_index=None, length_m=float("inf"), waypoints=[])
 
 
+def simplify_polyline(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """The points (k, 2) of a polyline that Douglas-Peucker keeps: both ends, and recursively the point
+    farthest from the chord between two kept ones while it is more than ``tolerance`` away.
+
+    The distance to a chord is the perpendicular one where the point projects strictly inside it, else
+    the distance to its nearer end; ties go to the first point. These are the distances and the tie
+    rule of ``skimage.measure.approximate_polygon`` (whose module pulls in ``scipy.signal``, a second
+    of import for every command), computed the same way so that every recorded path stays the same.
+
+    >>> simplify_polyline(np.array([[0.0, 0.0], [0.1, 1.0], [0.0, 2.0], [2.0, 2.0]]), 0.5)
+    array([[0., 0.],
+           [0., 2.],
+           [2., 2.]])
+    """
+    keep = np.zeros(len(points), dtype=bool)
+    keep[[0, -1]] = True
+    spans = [(0, len(points) - 1)]
+    while spans:
+        start, end = spans.pop()
+        (r0, c0), (r1, c1) = points[start], points[end]
+        dr, dc = r1 - r0, c1 - c0
+        angle = -np.arctan2(dr, dc)
+        offset = c0 * np.sin(angle) + r0 * np.cos(angle)
+        inner = points[start + 1:end]
+        dr0, dc0 = inner[:, 0] - r0, inner[:, 1] - c0
+        dr1, dc1 = inner[:, 0] - r1, inner[:, 1] - c1
+        across = ((dr0 * dr + dc0 * dc) > 0) & ((-dr1 * dr - dc1 * dc) > 0)
+        dist = np.where(across, np.abs(inner[:, 0] * np.cos(angle) + inner[:, 1] * np.sin(angle) - offset),
+                        np.minimum(np.sqrt(dc0 ** 2 + dr0 ** 2), np.sqrt(dc1 ** 2 + dr1 ** 2)))
+        if np.any(dist > tolerance):
+            split = start + int(np.argmax(dist)) + 1
+            keep[split] = True
+            spans += [(split, end), (start, split)]
+    return points[keep]
+
+
 def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     """Shortest 8-connected path over free cells from ``start`` to the nearest of ``goals``.
 
@@ -228,7 +263,7 @@ def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     cost, k = min(reached)
     path_yx = np.asarray(mcp.traceback(goals_yx[k]))
     cells = [(int(ix), int(iy)) for iy, ix in path_yx]
-    simplified = approximate_polygon(path_yx.astype(float), tolerance=1.0)
+    simplified = simplify_polyline(path_yx.astype(float), tolerance=1.0)
     waypoints = [(float(start[0]), float(start[1]))]
     waypoints += [grid.centre((int(round(ix)), int(round(iy)))) for iy, ix in simplified[1:-1]]
     waypoints.append((float(goals[goal_index[k]][0]), float(goals[goal_index[k]][1])))

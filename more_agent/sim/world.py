@@ -55,7 +55,8 @@ class World:
     version: int = 0
     layout_version: int = 0
     """Increases on every change of an object (pose, support, open state); unlike ``version``, not
-    when the robot merely moves, so renderers rebuild their geometry only when it changed."""
+    when the robot merely moves, so renderers rebuild their geometry only when it changed. Carrying an
+    item moves it but counts only when something rests in or on it: a held item is never drawn."""
     _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
     """Category -> how many instance labels of it have been handed out."""
 
@@ -248,7 +249,8 @@ class World:
         """Move the robot base; a held item moves along with it."""
         self.robot.x, self.robot.y, self.robot.yaw = float(x), float(y), float(np.arctan2(np.sin(yaw), np.cos(yaw)))
         self._carry()
-        self._changed(layout=self.robot.held is not None)  # a held item moved along
+        # a held item is never drawn: the layout changed only when something rests in / on it
+        self._changed(layout=self.robot.held is not None and bool(self.children(self.robot.held)))
 
     def _in_the_way(self, obj: WorldObject, support: WorldObject) -> list[WorldObject]:
         """What may stand where ``obj`` goes on ``support`` (``packing``): items already there and anything

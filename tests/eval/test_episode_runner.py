@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_episode
 from more_agent.eval.harness import config_specs
 from more_agent.eval.metrics import rtp
@@ -126,6 +128,7 @@ def test_unknown_task_is_recorded_not_raised() -> None:
     assert record.error_kind == "input"
 
 
+@pytest.mark.slow
 def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:
     from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
     from more_agent.eval.harness import evaluate

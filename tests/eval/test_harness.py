@@ -68,6 +68,7 @@ def test_raising_episode_is_recorded_and_run_finishes(tmp_path: Path) -> None:
     assert all(r.error is None for r in records if r.task != "bad")
 
 
+@pytest.mark.slow
 def test_process_pool_matches_inline_and_survives_dying_workers(tmp_path: Path) -> None:
     tasks = ["a", "die", "b", "c"]
     inline = evaluate(config("dying_episode", ["a", "b", "c"], seeds=2), tmp_path / "inline", show_progress=False)

@@ -97,6 +97,7 @@ def test_view_command_writes_the_page_and_refuses_other_folders(oracle_episode: 
     assert bad.exit_code == 2 and "episode folder (no episode.json)" in " ".join(bad.output.split())
 
 
+@pytest.mark.slow
 def test_run_and_eval_take_viewer(tmp_path: Path) -> None:
     from tests.eval.conftest import KITCHEN, TASK
 

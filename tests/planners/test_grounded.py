@@ -94,6 +94,7 @@ def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: Tas
     assert all(name != "go_to_and_place_inside" or ok for name, _, ok in actions)  # never places into a closed container
 
 
+@pytest.mark.slow
 def test_grounded_episode_is_deterministic_and_records_no_failure() -> None:
     spec = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="grounded")
     first, second = run_episode(spec), run_episode(spec)

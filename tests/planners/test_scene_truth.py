@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Embodiment, go_to_and
@@ -107,12 +108,14 @@ def _shuffle(world: World, rng: np.random.Generator, check: bool = True) -> tupl
     return placements, closed
 
 
+@pytest.mark.slow
 def test_scene_text_follows_many_random_placements_opens_and_closes() -> None:
     for seed in range(3):
         placements, closed = _shuffle(_world(seed), np.random.default_rng(100 + seed))
         assert placements >= 5 and closed  # the random draws did exercise placing and closing
 
 
+@pytest.mark.slow
 def test_observed_items_are_reached_from_a_random_start() -> None:
     """From this start the Voronoi node nearest hardback A lay beyond a gap narrower than the robot's
     clearance ("no path on the map"); the item itself was within arm's reach of the robot's part of the map."""

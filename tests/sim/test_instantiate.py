@@ -51,6 +51,7 @@ def _check_floor_items_clear(inst: TaskInstance) -> None:
                 assert np.any(gap >= 0), f"{inst.task}: {item.name} overlaps {f.name}"
 
 
+@pytest.mark.slow
 def test_every_paper_task_instantiates_or_fails_explicitly() -> None:
     failures = {}
     for task in task_set("more-paper"):
@@ -132,6 +133,7 @@ print(hashlib.sha256(repr(state).encode()).hexdigest())
 """
 
 
+@pytest.mark.slow
 def test_instantiation_is_the_same_under_every_string_hash_seed() -> None:
     """Two cabinets fit the task's cabinet scope: which one it binds must not follow Python's set order."""
     import os

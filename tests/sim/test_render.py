@@ -182,3 +182,25 @@ def test_rendering_is_deterministic_and_cached():
     assert renderer.geometry(world) is renderer.geometry(world)
     world.set_open("fridge_0", True)
     assert renderer.geometry(world).n_boxes == scene_geometry(world).n_boxes
+
+
+def test_carrying_rebuilds_the_geometry_only_when_something_rides_along():
+    """A held item is never drawn: carrying it keeps the cached geometry; carrying a tray with a mug on it
+    moves the mug, and the cached renderer draws it where a fresh one does."""
+    world = two_rooms()
+    world.set_robot_pose(4.8, 1.2, 0.0)
+    renderer = Renderer()
+    world.pick("mug_0")
+    held_alone = renderer.geometry(world)
+    world.set_robot_pose(5.0, 1.2, math.pi / 2)
+    assert renderer.geometry(world) is held_alone
+    world.add(WorldObject(name="tray_0", category="tray", kind="item", center=np.zeros(3), size=np.array([0.4, 0.3, 0.03])))
+    world.place("tray_0", "table_0", "ontop")
+    world.place("mug_0", "tray_0", "ontop")
+    world.pick("tray_0")
+    before = renderer.geometry(world)
+    world.set_robot_pose(5.0, 1.0, math.pi / 2)
+    assert renderer.geometry(world) is not before
+    cached, fresh = renderer.render(world), Renderer().render(world)
+    for name in ("depth", "semantic", "instance", "rgb"):
+        assert np.array_equal(getattr(cached, name), getattr(fresh, name), equal_nan=name == "depth")

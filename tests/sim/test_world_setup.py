@@ -67,6 +67,7 @@ def test_random_start_is_reachable_seeded_and_measured() -> None:
     assert rooms == {"kitchen_0", "corridor_0"}  # both rooms get drawn
 
 
+@pytest.mark.slow
 def test_random_start_draws_rooms_uniformly_random_area_draws_by_area() -> None:
     inst = instantiate("putting_shopping_away", "Rs_int", seed=0, start="task-room", distractors=False)
     world, rng = inst.world, np.random.default_rng(0)
