@@ -58,7 +58,9 @@ def parse_record(text: str | bytes, *, source: str) -> EpisodeRecord:
 def record_json(record: EpisodeRecord, *, indent: int | None = None) -> str:
     """The JSON text of ``record`` as it is written to disk, every string redacted (one line without ``indent``)."""
     separators = (",", ":") if indent is None else (",", ": ")
-    return json.dumps(redact_tree(record.model_dump(mode="json")), indent=indent, separators=separators, ensure_ascii=False)
+    return json.dumps(
+        redact_tree(record.model_dump(mode="json")), indent=indent, separators=separators, ensure_ascii=False
+    )
 
 
 def _refuse_constant(name: str) -> float:
@@ -101,10 +103,24 @@ def check_record(record: EpisodeRecord, *, source: str) -> None:
         raise BadRecord(f"{source}: {problems[0]}")
 
 
-_COUNTS = frozenset({
-    "seed", "high_level_steps", "low_level_steps", "step", "calls", "prompt_tokens", "completion_tokens",
-    "cache_hits", "images", "image_bytes", "image_tokens", "objects", "task_objects", "distractors",
-})
+_COUNTS = frozenset(
+    {
+        "seed",
+        "high_level_steps",
+        "low_level_steps",
+        "step",
+        "calls",
+        "prompt_tokens",
+        "completion_tokens",
+        "cache_hits",
+        "images",
+        "image_bytes",
+        "image_tokens",
+        "objects",
+        "task_objects",
+        "distractors",
+    }
+)
 """Integer fields of a record (at any depth) that count something: 0 .. MAX_COUNT."""
 
 

@@ -145,7 +145,9 @@ class ActionRecord(FrozenModel):
     name: str = Field(description="Subpolicy or action name, e.g. 'go_to_and_grasp'.")
     arguments: list[str] = Field(default_factory=list, description="Arguments as given.")
     ok: bool = Field(description="Whether the action succeeded.")
-    reason: FailureReason | None = Field(default=None, description="Why it failed (None on success, or when no reason applies).")
+    reason: FailureReason | None = Field(
+        default=None, description="Why it failed (None on success, or when no reason applies)."
+    )
     feedback: str = Field(default="", description="Feedback returned to the planner (failure reason if not ok).")
     low_level_steps: int = Field(default=0, description="Low-level steps (moves, turns) the action took.")
 
@@ -161,7 +163,8 @@ class LLMUsage(BaseModel):
     images: int = Field(default=0, description="Images sent (vision planners).")
     image_bytes: int = Field(default=0, description="Bytes of the images sent (decoded PNG).")
     image_tokens: int = Field(
-        default=0, description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server)."
+        default=0,
+        description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server).",
     )
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
@@ -197,11 +200,14 @@ class EpisodeRecord(BaseModel):
     task: str = Field(description="BEHAVIOR-1K activity name.")
     scene: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(description="Seed of scene generation and task instantiation.")
-    planner: str = Field(description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'.")
+    planner: str = Field(
+        description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'."
+    )
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
     start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
     distractors: bool | None = Field(
-        default=None, description="Whether the world held the scene's own small objects; None in records written before it was kept."
+        default=None,
+        description="Whether the world held the scene's own small objects; None in records written before it was kept.",
     )
     description: str = Field(default="", description="Language description the planner received.")
     descriptions: str = Field(
@@ -226,7 +232,9 @@ class EpisodeRecord(BaseModel):
     )
     llm_usage: LLMUsage = Field(default_factory=LLMUsage)
     timings: dict[str, float] = Field(default_factory=dict, description="Seconds per phase, e.g. 'instantiate'.")
-    world_stats: WorldStats | None = Field(default=None, description="Size and difficulty of the world; None if not built.")
+    world_stats: WorldStats | None = Field(
+        default=None, description="Size and difficulty of the world; None if not built."
+    )
     failure: Failure | None = Field(default=None, description="Why the episode failed; None for a success.")
     termination: Termination | None = Field(
         default=None, description="How the step loop ended; None when it did not end on its own (a system error)."
@@ -262,8 +270,16 @@ class EpisodeRecord(BaseModel):
     def for_spec(cls, spec: EpisodeSpec, **fields: object) -> EpisodeRecord:
         """A record of ``spec`` (an unset scene as ''), with ``fields`` set; the outcome fields at their defaults."""
         return cls(
-            task=spec.task, scene=spec.scene or "", seed=spec.seed, planner=spec.planner, llm=spec.llm, start=spec.start,
-            distractors=spec.distractors, descriptions=spec.descriptions, history=spec.history, **fields,
+            task=spec.task,
+            scene=spec.scene or "",
+            seed=spec.seed,
+            planner=spec.planner,
+            llm=spec.llm,
+            start=spec.start,
+            distractors=spec.distractors,
+            descriptions=spec.descriptions,
+            history=spec.history,
+            **fields,
         )
 
 
@@ -271,15 +287,22 @@ class EpisodeSpec(FrozenModel):
     """What to run: one (task, scene, seed, planner, llm) combination; the unit of evaluation work."""
 
     task: str = Field(description="BEHAVIOR-1K activity name.")
-    scene: str | None = Field(default=None, description="Scene name; None draws one with the seed among the task's suitable scenes.")
+    scene: str | None = Field(
+        default=None, description="Scene name; None draws one with the seed among the task's suitable scenes."
+    )
     seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
-    start: str = Field(default="random", description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.")
+    start: str = Field(
+        default="random",
+        description="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' or 'task-room'.",
+    )
     distractors: bool = Field(
-        default=True, description="Add the scene's own small objects as distractor items (False: only the task's objects)."
+        default=True,
+        description="Add the scene's own small objects as distractor items (False: only the task's objects).",
     )
     descriptions: str = Field(
-        default="named", description="'named': the paper's text naming every goal instance the world makes ambiguous; 'paper': verbatim."
+        default="named",
+        description="'named': the paper's text naming every goal instance the world makes ambiguous; 'paper': verbatim.",
     )
     history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")

@@ -48,7 +48,6 @@ def has_credentials(text: str) -> bool:
     return redact(text) != text
 
 
-
 def redact_tree(value: Any) -> Any:
     """``value`` (JSON-like: dicts, lists, strings, numbers) with every string :func:`redact`-ed."""
     if isinstance(value, str):

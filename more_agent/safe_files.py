@@ -116,7 +116,7 @@ def write_atomic(path: Path, data: bytes | str, *, durable: bool = True) -> None
         try:
             view = memoryview(payload)
             while view:
-                view = view[os.write(fd, view):]
+                view = view[os.write(fd, view) :]
             if durable:
                 os.fsync(fd)
         finally:

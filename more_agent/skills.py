@@ -53,21 +53,39 @@ class Skill:
 
 
 def _go_to_and(verb: str, what: str) -> Skill:
-    return Skill(f"go_to_and_{verb}", ("room", "object"), "go_to_and", verb, f"go to the object and {what}",
-                 f"go to the object and {what}")
+    return Skill(
+        f"go_to_and_{verb}",
+        ("room", "object"),
+        "go_to_and",
+        verb,
+        f"go to the object and {what}",
+        f"go to the object and {what}",
+    )
 
 
 SKILLS: tuple[Skill, ...] = (
-    Skill("explore", ("room",), "explore", None, "explore the closest unexplored area (frontier) in the room",
-          "explore the closest unexplored area (frontier)"),
+    Skill(
+        "explore",
+        ("room",),
+        "explore",
+        None,
+        "explore the closest unexplored area (frontier) in the room",
+        "explore the closest unexplored area (frontier)",
+    ),
     Skill("navigate", ("room", "object"), "navigate", "navigate_to", "go to the object", "go to the object"),
     _go_to_and("open", "open it"),
     _go_to_and("close", "close it"),
     _go_to_and("grasp", "pick it up (the hand must be empty)"),
     _go_to_and("place_inside", "put the held object inside it"),
     _go_to_and("place_ontop", "put the held object on top of it"),
-    Skill("done", (), "done", "done", "end the episode because the task is complete",
-          "end the episode because the task is complete"),
+    Skill(
+        "done",
+        (),
+        "done",
+        "done",
+        "end the episode because the task is complete",
+        "end the episode because the task is complete",
+    ),
 )
 """The paper's subpolicies, in the order the prompts list them."""
 

@@ -55,29 +55,43 @@ MAX_SEEDS = 10_000
 
 F = TypeVar("F", bound=Callable[..., object])
 
-StartOption = Annotated[str, typer.Option(
-    help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
-)]
+StartOption = Annotated[
+    str,
+    typer.Option(
+        help="Robot start: 'random' (a reachable room, then a pose in it), 'random-area' (uniform over the floor) or 'task-room'."
+    ),
+]
 """``--start`` of ``run`` and ``eval``."""
 
-DistractorsOption = Annotated[bool, typer.Option(
-    help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
-)]
+DistractorsOption = Annotated[
+    bool,
+    typer.Option(
+        help="Add the scene's own small objects as distractor items (--no-distractors: only the task's objects, as before the harder worlds)."
+    ),
+]
 """``--distractors/--no-distractors`` of ``run`` and ``eval``."""
 
-DescriptionsOption = Annotated[str, typer.Option(
-    help="Task descriptions: 'named' (the paper's text, naming every goal instance the world makes ambiguous and the "
-         "goal conditions it leaves out) or 'paper' (the paper's text verbatim)."
-)]
+DescriptionsOption = Annotated[
+    str,
+    typer.Option(
+        help="Task descriptions: 'named' (the paper's text, naming every goal instance the world makes ambiguous and the "
+        "goal conditions it leaves out) or 'paper' (the paper's text verbatim)."
+    ),
+]
 """``--descriptions`` of ``run`` and ``eval``."""
 
-HistoryOption = Annotated[str, typer.Option(
-    help="Action history of the LLM and VLM planners: 'paper' (the last five actions and every failed one) or "
-    "'lasting' (our extension: also every earlier successful grasp, place, open and close)."
-)]
+HistoryOption = Annotated[
+    str,
+    typer.Option(
+        help="Action history of the LLM and VLM planners: 'paper' (the last five actions and every failed one) or "
+        "'lasting' (our extension: also every earlier successful grasp, place, open and close)."
+    ),
+]
 """``--history`` of ``run`` and ``eval``."""
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")]
+JsonOption = Annotated[
+    bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")
+]
 """``--json`` of the listing commands and ``report``."""
 
 
@@ -98,8 +112,14 @@ class _SafeStderrHandler(logging.Handler):
             self.handleError(record)
 
 
-def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
-                  file: TextIO | None = None, line: str | None = None) -> None:
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
     """Python warnings on stderr without escape sequences (a library warning may quote a scene name)."""
     (file or sys.stderr).write(for_terminal(warnings.formatwarning(message, category, filename, lineno, line)))
 
@@ -118,7 +138,9 @@ def _install_log_handler() -> None:
 def print_error(message: str) -> None:
     """One red ``error:`` line on stderr; the message is printed as plain text (never as markup),
     redacted, without escape sequences."""
-    err_console.print(Text.assemble(("error:", "bold red"), " ", for_terminal(message)), highlight=False, soft_wrap=True)
+    err_console.print(
+        Text.assemble(("error:", "bold red"), " ", for_terminal(message)), highlight=False, soft_wrap=True
+    )
 
 
 def episodes_exit_status(records: Iterable[EpisodeRecord]) -> int:

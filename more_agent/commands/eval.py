@@ -29,13 +29,16 @@ RAY_ADDRESS = re.compile(r"local|auto|(ray://)?[A-Za-z0-9.\-\[\]:]+:\d{1,5}")
 @user_errors_exit_2
 def eval_(
     tasks: Annotated[str, typer.Option(help="Task set (more-paper, behavior-rearrange), a file of names, or 'a,b,c'.")],
-    planner: Annotated[str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr, bumble, bumble-filter.")],
+    planner: Annotated[
+        str, typer.Option(help="Planner name, e.g. oracle, more, moma-llm, moma-llm-sr, bumble, bumble-filter.")
+    ],
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     seeds: Annotated[int, typer.Option(min=1, max=MAX_SEEDS, help="Seeds per task: 0 .. N-1.")] = 1,
-    scene: Annotated[str | None, typer.Option(
-        help="Scene for every task (default: drawn per episode among each task's suitable scenes)."
-    )] = None,
+    scene: Annotated[
+        str | None,
+        typer.Option(help="Scene for every task (default: drawn per episode among each task's suitable scenes)."),
+    ] = None,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
@@ -58,7 +61,10 @@ def eval_(
     episode_fn: Annotated[str | None, typer.Option(help="Episode function 'module:function' (advanced).")] = None,
     progress: Annotated[bool, typer.Option(help="Show the progress bar.")] = True,
     viewer: Annotated[
-        bool, typer.Option("--viewer", help="Save frames and maps and write each episode's viewer.html (linked from report.html).")
+        bool,
+        typer.Option(
+            "--viewer", help="Save frames and maps and write each episode's viewer.html (linked from report.html)."
+        ),
     ] = False,
 ) -> None:
     """Evaluate a planner over a task set; one JSON line per episode in OUT/episodes.jsonl.
@@ -84,14 +90,19 @@ def eval_(
         episode_fn = VIEWER_EPISODE_FN
     check_run_dir(out)
     if ray_address is not None and not RAY_ADDRESS.fullmatch(ray_address):
-        raise UserError(f"--ray-address {ray_address!r} is not 'local', 'auto' or HOST:PORT (e.g. ray://10.0.0.5:10001)")
+        raise UserError(
+            f"--ray-address {ray_address!r} is not 'local', 'auto' or HOST:PORT (e.g. ray://10.0.0.5:10001)"
+        )
     if llm is not None:
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     names = resolve_tasks(tasks)
     check_start(start)
     check_description_mode(descriptions)
     history_mode = check_history(history)
-    if episode_fn in (None, VIEWER_EPISODE_FN):  # the real episode functions run BEHAVIOR-1K activities: check everything now
+    if episode_fn in (
+        None,
+        VIEWER_EPISODE_FN,
+    ):  # the real episode functions run BEHAVIOR-1K activities: check everything now
         from more_agent.planners.base import make_planner
         from more_agent.sim.scenes import get_scene
 
@@ -117,30 +128,44 @@ def eval_(
         more_agent_version=__version__,
     )
     records = evaluate(
-        config, out, resume=resume, retry_errors=retry_errors, allow_mixed=allow_mixed,
-        max_concurrent_llm=max_llm_calls, max_retries=max_retries, show_progress=progress,
+        config,
+        out,
+        resume=resume,
+        retry_errors=retry_errors,
+        allow_mixed=allow_mixed,
+        max_concurrent_llm=max_llm_calls,
+        max_retries=max_retries,
+        show_progress=progress,
     )
     sourced, _ = load_runs([out])
     paths = write_reports(sourced, out, title=f"{planner} on {tasks}")
     typer.echo(table_i_markdown([s.record for s in sourced]))
     errors = sum(r.error is not None for r in records)
     if errors:
-        err_console.print(f"{errors} episode(s) ended with an error; see {out / 'report.html'}",
-                          style="yellow", highlight=False, markup=False)
+        err_console.print(
+            f"{errors} episode(s) ended with an error; see {out / 'report.html'}",
+            style="yellow",
+            highlight=False,
+            markup=False,
+        )
     err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False)
     status = episodes_exit_status(records)
     if status == EXIT_FAILED:
         err_console.print(
             "some episodes ended in a system error (code raised, the LLM refused the request or the key); "
             f"see their 'error' in {out / 'episodes.jsonl'} (exit status {EXIT_FAILED})",
-            style="yellow", highlight=False, markup=False,
+            style="yellow",
+            highlight=False,
+            markup=False,
         )
     elif status == EXIT_RETRYABLE:
         err_console.print(
             f"{sum(r.retryable for r in records)} episode(s) hit a transient error (LLM transport, worker death) and "
             f"are not results: re-run them with: more-agent eval ... --out {out} --resume --retry-errors "
             f"(exit status {EXIT_RETRYABLE})",
-            style="yellow", highlight=False, markup=False,
+            style="yellow",
+            highlight=False,
+            markup=False,
         )
     if status:
         raise typer.Exit(code=status)

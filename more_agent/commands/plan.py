@@ -28,16 +28,23 @@ def read_history(path: Path) -> list[ActionRecord]:
         actions = data.get("actions", []) if isinstance(data, dict) else data
         return TypeAdapter(list[ActionRecord]).validate_python(actions)
     except (OSError, ValueError, ValidationError) as e:
-        raise UserError(f"--history {path}: expected a JSON list of actions "
-                        f"({{step, name, arguments, ok, feedback}}): {' '.join(str(e).splitlines()[:2])}") from None
+        raise UserError(
+            f"--history {path}: expected a JSON list of actions "
+            f"({{step, name, arguments, ok, feedback}}): {' '.join(str(e).splitlines()[:2])}"
+        ) from None
 
 
 @user_errors_exit_2
 def plan(
-    graph: Annotated[Path, typer.Option(help="Scene graph: ours (scene_graph.json of ingest) or Spark-DSG (.json, .sparkdsg, .bson).")],
+    graph: Annotated[
+        Path,
+        typer.Option(help="Scene graph: ours (scene_graph.json of ingest) or Spark-DSG (.json, .sparkdsg, .bson)."),
+    ],
     task: Annotated[str, typer.Option(help="The task in words, e.g. 'put the apple in the fridge'.")],
     history: Annotated[Path | None, typer.Option(help="JSON list of the actions so far (as in episode.json).")] = None,
-    llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (default: the configured one).")] = None,
+    llm: Annotated[
+        str | None, typer.Option(help="LLM spec such as openai:gpt-4o (default: the configured one).")
+    ] = None,
     planner: Annotated[str, typer.Option(help="LLM planner: more, moma-llm or moma-llm-sr.")] = "more",
     label_map: Annotated[Path | None, typer.Option(help="Spark-DSG graphs: JSON {semantic label: class name}.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the decision as JSON.")] = False,

@@ -19,7 +19,8 @@ from more_agent.commands._common import (
 def report(
     run_dirs: Annotated[list[Path], typer.Argument(help="Run directories written by 'more-agent eval'.")],
     out: Annotated[
-        Path | None, typer.Option(help="Also write summary.md, summary.csv, report.html and the comparison plots (PNG) here.")
+        Path | None,
+        typer.Option(help="Also write summary.md, summary.csv, report.html and the comparison plots (PNG) here."),
     ] = None,
     per_task: Annotated[bool, typer.Option(help="Print the per-task table too.")] = False,
     as_json: JsonOption = False,
@@ -32,11 +33,15 @@ def report(
     sourced, dropped = load_runs(run_dirs)
     records = [s.record for s in sourced]
     if as_json:
-        print_json({
-            "systems": [{"system": k, **s.model_dump()} for k, s in by_system(records).items()],
-            "tasks": [{"system": k, "task": t, **s.model_dump()} for (k, t), s in by_task(records).items()] if per_task else [],
-            "dropped_duplicates": dropped,
-        })
+        print_json(
+            {
+                "systems": [{"system": k, **s.model_dump()} for k, s in by_system(records).items()],
+                "tasks": [{"system": k, "task": t, **s.model_dump()} for (k, t), s in by_task(records).items()]
+                if per_task
+                else [],
+                "dropped_duplicates": dropped,
+            }
+        )
     else:
         typer.echo(table_i_markdown(records))
         if per_task:

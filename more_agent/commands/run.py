@@ -80,13 +80,21 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
     table.add_column(style="bold")
     table.add_column()
     verdict = Text("success", style="green") if record.success else Text("failure", style="red")
-    table.add_row("episode", Text(for_terminal(f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}")))
-    table.add_row("result", Text.assemble(verdict, f"; goals met: {record.all_goals_met}; done called: {record.done_called}"))
+    table.add_row(
+        "episode", Text(for_terminal(f"{record.task} in {record.scene} (seed {record.seed}), planner {record.planner}"))
+    )
+    table.add_row(
+        "result", Text.assemble(verdict, f"; goals met: {record.all_goals_met}; done called: {record.done_called}")
+    )
     met = sum(c.satisfied for c in record.goal_conditions)
     table.add_row("progress", f"{record.task_progress:.2f} ({met}/{len(record.goal_conditions)} goal conditions)")
     table.add_row("steps", f"{record.high_level_steps} high-level, {record.low_level_steps} low-level")
     table.add_row("time", f"{record.timings.get('total', 0.0):.2f} s")
-    why = record.error or record.gave_up or (describe(record.termination) if record.termination and not record.success else "")
+    why = (
+        record.error
+        or record.gave_up
+        or (describe(record.termination) if record.termination and not record.success else "")
+    )
     if why:
         table.add_row("why", Text(for_terminal(why)))  # may quote a server: never markup nor escapes
     names = (EPISODE_FILE, MAP_FILE, VIEWER_FILE)
@@ -98,25 +106,42 @@ def summary_table(record: EpisodeRecord, out_dir: Path) -> Table:
 @user_errors_exit_2
 def run(
     task: Annotated[str, typer.Argument(help="BEHAVIOR-1K activity name, e.g. putting_shopping_away.")],
-    planner: Annotated[str | None, typer.Option(help="Planner name (default: more with an LLM, grounded without).")] = None,
-    scene: Annotated[str | None, typer.Option(
-        help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
-    )] = None,
-    seed: Annotated[int, typer.Option(
-        min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation, instantiation and start pose."
-    )] = 0,
+    planner: Annotated[
+        str | None, typer.Option(help="Planner name (default: more with an LLM, grounded without).")
+    ] = None,
+    scene: Annotated[
+        str | None,
+        typer.Option(
+            help="Scene name or scene .json file (default: drawn with the seed among the task's suitable scenes)."
+        ),
+    ] = None,
+    seed: Annotated[
+        int,
+        typer.Option(
+            min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation, instantiation and start pose."
+        ),
+    ] = 0,
     start: StartOption = "random",
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
     history: HistoryOption = "paper",
-    out: Annotated[Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")] = None,
-    save_frames: Annotated[bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")] = False,
+    out: Annotated[
+        Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")
+    ] = None,
+    save_frames: Annotated[
+        bool, typer.Option("--save-frames", help="Also write the sensor frames of every step.")
+    ] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
     llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
-    viewer: Annotated[bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")] = False,
-    bag: Annotated[Path | None, typer.Option(
-        help="Also record the robot's sensor stream as a ROS 2 bag folder (new path; 'ros' extra; docs/ros.md)."
-    )] = None,
+    viewer: Annotated[
+        bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")
+    ] = False,
+    bag: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also record the robot's sensor stream as a ROS 2 bag folder (new path; 'ros' extra; docs/ros.md)."
+        ),
+    ] = None,
     bag_storage: Annotated[str, typer.Option(help="Storage of --bag: mcap or sqlite3.")] = "mcap",
 ) -> None:
     """Run one episode of TASK and write its record and map.
@@ -148,14 +173,30 @@ def run(
     out_dir = out if out is not None else default_out_dir(task, scene, seed, planner)
     check_writable_dir(out_dir)
     spec = EpisodeSpec(
-        task=task, scene=scene, seed=seed, planner=planner, llm=agent.llm, start=start, distractors=distractors,
-        descriptions=descriptions, history=history_mode,
+        task=task,
+        scene=scene,
+        seed=seed,
+        planner=planner,
+        llm=agent.llm,
+        start=start,
+        distractors=distractors,
+        descriptions=descriptions,
+        history=history_mode,
     )
     recorder = open_bag_recorder(bag, bag_storage) if bag is not None else None
-    with locked_run_dir(out_dir), console.status(f"running {task} with planner {planner} ..."), recorder or nullcontext():
+    with (
+        locked_run_dir(out_dir),
+        console.status(f"running {task} with planner {planner} ..."),
+        recorder or nullcontext(),
+    ):
         check_folder_for(out_dir, spec)
         record = (run_episode_with_viewer if viewer else run_episode)(
-            spec, out_dir=out_dir, save_frames=save_frames, save_graph=save_graph, strict=True, planner=agent,
+            spec,
+            out_dir=out_dir,
+            save_frames=save_frames,
+            save_graph=save_graph,
+            strict=True,
+            planner=agent,
             bag=recorder,
         )
     console.print(summary_table(record, out_dir))

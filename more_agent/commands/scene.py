@@ -54,16 +54,28 @@ def show(scene: str = SCENE_ARG, seed: int = SEED_OPT, as_json: JsonOption = Fal
     if as_json:
         print_json(_show_json(s))
         return
-    console.print(f"[bold]{escape(s.name)}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
-                  f"{len(s.windows)} windows, {len(s.furniture)} furniture, {len(s.walls)} wall boxes")
+    console.print(
+        f"[bold]{escape(s.name)}[/] seed {s.seed}: {len(s.rooms)} rooms, {len(s.doors)} doors, "
+        f"{len(s.windows)} windows, {len(s.furniture)} furniture, {len(s.walls)} wall boxes"
+    )
     rooms = Table("room", "type", "area m²", "ground", "outdoor", "doors to", "furniture")
     for r in s.rooms:
         area = (r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1])
-        links = [f"{d.id}:{next(x for x in d.rooms if x != r.id)}{'' if d.open else ' (closed)'}"
-                 for d in s.doors if r.id in d.rooms]
+        links = [
+            f"{d.id}:{next(x for x in d.rooms if x != r.id)}{'' if d.open else ' (closed)'}"
+            for d in s.doors
+            if r.id in d.rooms
+        ]
         counts = Counter(f.category for f in s.furniture if f.room == r.id)
-        cells = (r.id, r.type, f"{area:.1f}", r.ground, "yes" if r.outdoor else "",
-                 ", ".join(links), ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())))
+        cells = (
+            r.id,
+            r.type,
+            f"{area:.1f}",
+            r.ground,
+            "yes" if r.outdoor else "",
+            ", ".join(links),
+            ", ".join(f"{c}×{n}" if n > 1 else c for c, n in sorted(counts.items())),
+        )
         rooms.add_row(*map(escape, cells))  # a hand-written scene file may hold any text
     console.print(rooms)
 
@@ -73,14 +85,30 @@ def _show_json(s: Scene) -> dict[str, object]:
     rooms = []
     for r in s.rooms:
         counts = Counter(f.category for f in s.furniture if f.room == r.id)
-        rooms.append({
-            "id": r.id, "type": r.type, "area_m2": round((r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1]), 3),
-            "ground": r.ground, "outdoor": r.outdoor,
-            "doors": [{"door": d.id, "to": next(x for x in d.rooms if x != r.id), "open": d.open} for d in s.doors if r.id in d.rooms],
-            "furniture": dict(sorted(counts.items())),
-        })
-    return {"scene": s.name, "seed": s.seed, "n_doors": len(s.doors), "n_windows": len(s.windows),
-            "n_furniture": len(s.furniture), "n_wall_boxes": len(s.walls), "rooms": rooms}
+        rooms.append(
+            {
+                "id": r.id,
+                "type": r.type,
+                "area_m2": round((r.bounds[2] - r.bounds[0]) * (r.bounds[3] - r.bounds[1]), 3),
+                "ground": r.ground,
+                "outdoor": r.outdoor,
+                "doors": [
+                    {"door": d.id, "to": next(x for x in d.rooms if x != r.id), "open": d.open}
+                    for d in s.doors
+                    if r.id in d.rooms
+                ],
+                "furniture": dict(sorted(counts.items())),
+            }
+        )
+    return {
+        "scene": s.name,
+        "seed": s.seed,
+        "n_doors": len(s.doors),
+        "n_windows": len(s.windows),
+        "n_furniture": len(s.furniture),
+        "n_wall_boxes": len(s.walls),
+        "rooms": rooms,
+    }
 
 
 @app.command("generate")

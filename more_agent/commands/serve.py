@@ -12,8 +12,12 @@ from more_agent.commands._common import err_console, user_errors_exit_2
 
 @user_errors_exit_2
 def serve(
-    llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (default: the configured one).")] = None,
-    host: Annotated[str, typer.Option(help="Address to listen on (0.0.0.0: every interface; there is no auth).")] = "127.0.0.1",
+    llm: Annotated[
+        str | None, typer.Option(help="LLM spec such as openai:gpt-4o (default: the configured one).")
+    ] = None,
+    host: Annotated[
+        str, typer.Option(help="Address to listen on (0.0.0.0: every interface; there is no auth).")
+    ] = "127.0.0.1",
     port: Annotated[int, typer.Option(min=1, max=65535, help="TCP port.")] = 8000,
 ) -> None:
     """Serve one MORE decision per request until Ctrl-C; without an LLM, say how to configure one."""

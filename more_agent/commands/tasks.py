@@ -31,8 +31,18 @@ def list_(
     data = task_data()["tasks"]
     names = task_set(set_) if set_ is not None else sorted(data)  # the package data holds every activity
     if as_json:
-        print_json([{"task": name, "n_objects": data[name]["n_objects"], "n_goal_literals": data[name]["n_goal_literals"],
-                     "instantiable": data[name]["instantiable"], "scenes": data[name]["scenes"]} for name in names])
+        print_json(
+            [
+                {
+                    "task": name,
+                    "n_objects": data[name]["n_objects"],
+                    "n_goal_literals": data[name]["n_goal_literals"],
+                    "instantiable": data[name]["instantiable"],
+                    "scenes": data[name]["scenes"],
+                }
+                for name in names
+            ]
+        )
         return
     table = Table(title=f"{len(names)} tasks" + (f" in {set_}" if set_ else ""))
     table.add_column("task", no_wrap=True)
@@ -42,7 +52,9 @@ def list_(
         e = data[name]
         scenes = e["scenes"]
         shown = ", ".join(scenes[:3]) + (f" (+{len(scenes) - 3})" if len(scenes) > 3 else "")
-        table.add_row(name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-")
+        table.add_row(
+            name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-"
+        )
     console.print(table)
 
 
@@ -51,7 +63,9 @@ def list_(
 def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
     scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: drawn with the seed).")] = None,
-    seed: Annotated[int, typer.Option(min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation and instantiation.")] = 0,
+    seed: Annotated[
+        int, typer.Option(min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation and instantiation.")
+    ] = 0,
     as_json: JsonOption = False,
 ) -> None:
     """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
@@ -73,8 +87,12 @@ def show(
     console.print(task, style="bold", highlight=False, markup=False)
     console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False, markup=False)
     drawn = draw_scenes(task, seed)
-    console.print(f"episode scenes ({len(drawn)}, {', '.join(EXCLUDED_SCENES)} left out); "
-                  f"drawn for seed {seed}: {drawn[0] if drawn else '-'}", highlight=False, markup=False)
+    console.print(
+        f"episode scenes ({len(drawn)}, {', '.join(EXCLUDED_SCENES)} left out); "
+        f"drawn for seed {seed}: {drawn[0] if drawn else '-'}",
+        highlight=False,
+        markup=False,
+    )
     if scene is not None:
         check_scene_suits(task, scene)
     console.print("goal:", highlight=False)
@@ -83,8 +101,9 @@ def show(
     if not scenes and scene is None:
         return
     inst = instantiate(task, scene, seed)
-    console.print(f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False,
-                  markup=False)
+    console.print(
+        f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False, markup=False
+    )
     console.print(f"description: {inst.description}", highlight=False, markup=False)
     table = Table(title="objects")
     for col in ("scope", "world object", "label", "category", "where"):
@@ -95,7 +114,9 @@ def show(
         table.add_row(*map(escape, (s, name, inst.label(s), obj.category if obj else "-", where)))
     console.print(table)
     if inst.unsupported_literals:
-        console.print("init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False)
+        console.print(
+            "init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False
+        )
 
 
 def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
@@ -114,17 +135,33 @@ def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
     if scene is not None:
         check_scene_suits(task, scene)
     out: dict[str, object] = {
-        "task": task, "suitable_scenes": scenes, "episode_scenes": drawn, "seed": seed,
-        "goal": [literal_text(lit) for lit in definition.goal], "instance": None,
+        "task": task,
+        "suitable_scenes": scenes,
+        "episode_scenes": drawn,
+        "seed": seed,
+        "goal": [literal_text(lit) for lit in definition.goal],
+        "instance": None,
     }
     if scenes or scene is not None:
         inst = instantiate(task, scene, seed)
         objects = []
         for s, name in inst.scope.items():
             obj = inst.world.objects.get(name)
-            objects.append({"scope": s, "object": name, "label": inst.label(s), "category": obj.category if obj else None,
-                            "relation": obj.relation if obj else None, "parent": obj.parent if obj else None,
-                            "room": obj.room if obj else None})
-        out["instance"] = {"scene": inst.scene, "description": inst.description, "objects": objects,
-                           "unsupported_literals": list(inst.unsupported_literals)}
+            objects.append(
+                {
+                    "scope": s,
+                    "object": name,
+                    "label": inst.label(s),
+                    "category": obj.category if obj else None,
+                    "relation": obj.relation if obj else None,
+                    "parent": obj.parent if obj else None,
+                    "room": obj.room if obj else None,
+                }
+            )
+        out["instance"] = {
+            "scene": inst.scene,
+            "description": inst.description,
+            "objects": objects,
+            "unsupported_literals": list(inst.unsupported_literals),
+        }
     return out

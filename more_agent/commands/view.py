@@ -12,12 +12,17 @@ from more_agent.commands._common import err_console, user_errors_exit_2
 
 @user_errors_exit_2
 def view(
-    episode_dir: Annotated[Path, typer.Argument(help="Episode folder written by 'more-agent run' or 'eval' (holds episode.json).")],
+    episode_dir: Annotated[
+        Path, typer.Argument(help="Episode folder written by 'more-agent run' or 'eval' (holds episode.json).")
+    ],
     out: Annotated[Path | None, typer.Option(help="HTML file to write (default: EPISODE_DIR/viewer.html).")] = None,
-    rerun: Annotated[Path | None, typer.Option(
-        help="Write a Rerun recording (.rrd) instead of the page: frames, voxel map, path, scene graph, actions "
-        "('rerun' extra)."
-    )] = None,
+    rerun: Annotated[
+        Path | None,
+        typer.Option(
+            help="Write a Rerun recording (.rrd) instead of the page: frames, voxel map, path, scene graph, actions "
+            "('rerun' extra)."
+        ),
+    ] = None,
 ) -> None:
     """Write an HTML page that steps through the episode: frames, map, scene text, LLM requests and answers
     (or, with --rerun, a Rerun recording of it)."""
@@ -27,8 +32,11 @@ def view(
 
         check_output_file(rerun)
         summary = write_rerun(episode_dir, rerun)
-        err_console.print(f"wrote {rerun}: {summary.steps} steps, {summary.frames} frames, {summary.graphs} scene graphs "
-                          "(open it with: rerun FILE)", highlight=False)
+        err_console.print(
+            f"wrote {rerun}: {summary.steps} steps, {summary.frames} frames, {summary.graphs} scene graphs "
+            "(open it with: rerun FILE)",
+            highlight=False,
+        )
         return
     from more_agent.eval.viewer import write_viewer
 

@@ -106,8 +106,15 @@ def run_episode(
 
     clock = _Clock()
     record = EpisodeRecord.for_spec(spec)
-    folder = None if out_dir is None else EpisodeFolder(
-        Path(out_dir), frames=save_frames or viewer, graphs=save_graph or viewer, graph_pictures=save_graph,
+    folder = (
+        None
+        if out_dir is None
+        else EpisodeFolder(
+            Path(out_dir),
+            frames=save_frames or viewer,
+            graphs=save_graph or viewer,
+            graph_pictures=save_graph,
+        )
     )
     world: World | None = None
     goals: GoalChecker | None = None
@@ -116,8 +123,14 @@ def run_episode(
         folder.clear()  # an earlier episode's steps and frames must never show in this one's viewer
     try:
         t = time.perf_counter()
-        instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
-                               descriptions=spec.descriptions)
+        instance = instantiate(
+            spec.task,
+            spec.scene,
+            spec.seed,
+            start=spec.start,
+            distractors=spec.distractors,
+            descriptions=spec.descriptions,
+        )
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
@@ -127,11 +140,16 @@ def run_episode(
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
-        planner.reset(EpisodeContext(
-            instance=instance, goals=goals, llm=planner.llm, history=spec.history,
-            on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
-            trace_graphs=folder is not None and folder.graphs,
-        ))
+        planner.reset(
+            EpisodeContext(
+                instance=instance,
+                goals=goals,
+                llm=planner.llm,
+                history=spec.history,
+                on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
+                trace_graphs=folder is not None and folder.graphs,
+            )
+        )
         clock.add("sense", t)
         if folder is not None:
             folder.start(steps_log=planner.llm is not None)
@@ -190,13 +208,18 @@ def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     rebuilt from (task, scene, seed, start, distractors, descriptions) in its initial state (objects where they started)."""
     from more_agent.sim.instantiate import instantiate
 
-    instance = instantiate(spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors,
-                           descriptions=spec.descriptions)
+    instance = instantiate(
+        spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors, descriptions=spec.descriptions
+    )
     EpisodeFolder(out_dir).write_map(record, instance.world, set(instance.scope.values()))
 
 
 def _run_steps(
-    record: EpisodeRecord, planner: Planner, goals: GoalChecker, world: World, clock: _Clock,
+    record: EpisodeRecord,
+    planner: Planner,
+    goals: GoalChecker,
+    world: World,
+    clock: _Clock,
     folder: EpisodeFolder | None = None,
 ) -> None:
     """High-level steps until done(), the step limit, or too many steps after the goal (paper Sec. III-D);
@@ -214,10 +237,17 @@ def _run_steps(
         result = planner.body.since_last_report(planner.execute(action))
         status = goals.check(world)
         clock.add("act", t)
-        record.actions.append(ActionRecord(
-            step=record.high_level_steps, name=action.name, arguments=list(action.arguments), ok=result.ok,
-            reason=result.reason, feedback=clip(result.feedback, MAX_FEEDBACK_CHARS), low_level_steps=result.low_level_steps,
-        ))
+        record.actions.append(
+            ActionRecord(
+                step=record.high_level_steps,
+                name=action.name,
+                arguments=list(action.arguments),
+                ok=result.ok,
+                reason=result.reason,
+                feedback=clip(result.feedback, MAX_FEEDBACK_CHARS),
+                low_level_steps=result.low_level_steps,
+            )
+        )
         record.high_level_steps += 1
         record.low_level_steps += result.low_level_steps
         _extend_path(record.trajectory, result.path)

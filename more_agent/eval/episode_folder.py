@@ -73,7 +73,13 @@ def check_folder_for(path: Path, spec: EpisodeSpec) -> None:
         old = read_record(record_path)
     except UserError:
         return
-    same = (old.task, old.seed, old.planner, old.llm, old.start) == (spec.task, spec.seed, spec.planner, spec.llm, spec.start)
+    same = (old.task, old.seed, old.planner, old.llm, old.start) == (
+        spec.task,
+        spec.seed,
+        spec.planner,
+        spec.llm,
+        spec.start,
+    )
     same = same and old.distractors in (None, spec.distractors)
     same = same and (spec.scene is None or spec.scene.endswith(".json") or spec.scene == old.scene)
     if not same:
@@ -120,8 +126,16 @@ class EpisodeFolder:
 
     def owned_paths(self) -> list[Path]:
         """Every file and folder of an episode this module writes (what :meth:`clear` removes)."""
-        return [self.record_path, self.map_path, self.timeline_path, self.steps_path, self.viewer_path,
-                self.frames_dir, self.graphs_dir, self.path / VLM_IMAGES_DIR]
+        return [
+            self.record_path,
+            self.map_path,
+            self.timeline_path,
+            self.steps_path,
+            self.viewer_path,
+            self.frames_dir,
+            self.graphs_dir,
+            self.path / VLM_IMAGES_DIR,
+        ]
 
     # -- writing --------------------------------------------------------------------------------
     def clear(self) -> None:
@@ -174,15 +188,18 @@ class EpisodeFolder:
                 write_atomic(path, png, durable=False)
         if self.graphs and trace.graph is not None:
             self._write_graph(step, trace.graph)
-        _append_line(self.timeline_path, {
-            "step": step,
-            "path_len": len(record.trajectory),
-            "low_level_steps": record.low_level_steps,
-            "frames": self.frames_written,
-            "goals": [[c.text, c.satisfied] for c in status.conditions],
-            "progress": round(status.progress, 4),
-            "targets": targets,
-        })
+        _append_line(
+            self.timeline_path,
+            {
+                "step": step,
+                "path_len": len(record.trajectory),
+                "low_level_steps": record.low_level_steps,
+                "frames": self.frames_written,
+                "goals": [[c.text, c.satisfied] for c in status.conditions],
+                "progress": round(status.progress, 4),
+                "targets": targets,
+            },
+        )
 
     def _write_graph(self, step: int, graph: SceneGraph) -> None:
         from more_agent.viz.graph_plot import occupancy_png, scene_graph_png
@@ -202,8 +219,9 @@ class EpisodeFolder:
         from more_agent.viz.trajectory import trajectory_map_png
 
         try:
-            png = trajectory_map_png(world, record.trajectory, title=f"{record.task} ({record.scene}, {record.planner})",
-                                     labelled=labelled)
+            png = trajectory_map_png(
+                world, record.trajectory, title=f"{record.task} ({record.scene}, {record.planner})", labelled=labelled
+            )
             write_atomic(self.map_path, png)
         except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome
             log.warning("could not draw %s: %s: %s", self.map_path, type(e).__name__, e)

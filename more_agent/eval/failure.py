@@ -19,8 +19,16 @@ from more_agent.sim.world import World
 from more_agent.skills import SKILLS
 
 CAUSE_ORDER: tuple[FailureCause, ...] = (
-    "llm_error", "other", "done_not_called", "wrong_instance", "never_observed", "invalid_llm_answers",
-    "unreachable", "subpolicy_failure", "done_early", "step_limit",
+    "llm_error",
+    "other",
+    "done_not_called",
+    "wrong_instance",
+    "never_observed",
+    "invalid_llm_answers",
+    "unreachable",
+    "subpolicy_failure",
+    "done_early",
+    "step_limit",
 )
 """Causes in the order they are tested; 'other' here means a system error other than the LLM's (code raised,
 bad input: ``record.error``) or an episode that never ran."""
@@ -60,12 +68,16 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
         return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
     invalid = sum(a.reason is FailureReason.INVALID_ANSWER for a in record.actions)
     if record.actions and invalid / len(record.actions) >= INVALID_SHARE:
-        return Failure(cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers")
+        return Failure(
+            cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers"
+        )
     refs = {ref for o in needed for ref in (o, labels[o])}  # the oracle names world objects, the others labels
     on_needed = [a for a in record.actions if not a.ok and refs & set(a.arguments)]
     reach = [a for a in on_needed if is_reach_failure(a)]
     if reach:
-        return Failure(cause="unreachable", detail=f"{reach[-1].name}({', '.join(reach[-1].arguments)}): {reach[-1].feedback}")
+        return Failure(
+            cause="unreachable", detail=f"{reach[-1].name}({', '.join(reach[-1].arguments)}): {reach[-1].feedback}"
+        )
     if on_needed:
         last = on_needed[-1]
         return Failure(cause="subpolicy_failure", detail=f"{last.name}({', '.join(last.arguments)}): {last.feedback}")
@@ -75,7 +87,9 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     return Failure(cause="step_limit", detail=f"{ended or 'step limit'}; {first_unmet} unmet")
 
 
-def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World) -> str:
+def _wrong_instances(
+    actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World
+) -> str:
     """'acted on cup B; the goal needs cup A'-style detail when the robot manipulated another instance of a
     needed object's category, one the goal does not name at all, but never the needed one; '' otherwise."""
     goal_refs = goal_objects | {world.get(o).label for o in goal_objects if o in world.objects}
@@ -84,8 +98,11 @@ def _wrong_instances(actions: Sequence[ActionRecord], needed: Sequence[str], goa
         obj = world.get(name)
         if obj.label in touched or name in touched:
             continue
-        others = sorted(t for t in touched - goal_refs
-                        if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category)
+        others = sorted(
+            t
+            for t in touched - goal_refs
+            if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category
+        )
         if others:
             return f"acted on {', '.join(others)}; the goal needs {obj.label or name + ' (never observed)'}"
     return ""

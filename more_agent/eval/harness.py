@@ -53,7 +53,6 @@ MAX_TASK_FILE_BYTES = 1024 * 1024
 """Largest ``--tasks`` file read (about 30,000 task names)."""
 
 
-
 # ---------------------------------------------------------------------------------------------
 # What to run
 
@@ -85,7 +84,9 @@ def resolve_tasks(arg: str, *, task_set: Callable[[str], list[str]] | None = Non
             try:
                 names = json.loads(text)
             except (json.JSONDecodeError, RecursionError) as e:
-                raise UserError(f"{path}: not a JSON list of task names: {str(e)[:200] or 'nested too deeply'}") from None
+                raise UserError(
+                    f"{path}: not a JSON list of task names: {str(e)[:200] or 'nested too deeply'}"
+                ) from None
             if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
                 raise UserError(f"{path}: expected a JSON list of task names (strings)")
         else:
@@ -112,8 +113,15 @@ def config_specs(config: RunConfig) -> list[EpisodeSpec]:
     """Every episode of a run: tasks x seeds, task-major."""
     return [
         EpisodeSpec(
-            task=t, scene=config.scene, seed=s, planner=config.planner, llm=config.llm, start=config.start,
-            distractors=config.distractors, descriptions=config.descriptions, history=config.history,
+            task=t,
+            scene=config.scene,
+            seed=s,
+            planner=config.planner,
+            llm=config.llm,
+            start=config.start,
+            distractors=config.distractors,
+            descriptions=config.descriptions,
+            history=config.history,
         )
         for t in config.tasks
         for s in config.seeds
@@ -270,8 +278,16 @@ def evaluate(
             records = retire_retryable(run_dir, records)
         if resume and config.episode_fn == DEFAULT_EPISODE_FN:
             redraw_missing_maps(config, run_dir, records)
-        return _run_pending(config, run_dir, records, max_concurrent_llm=max_concurrent_llm, max_retries=max_retries,
-                            start_method=start_method, show_progress=show_progress, console=console)
+        return _run_pending(
+            config,
+            run_dir,
+            records,
+            max_concurrent_llm=max_concurrent_llm,
+            max_retries=max_retries,
+            start_method=start_method,
+            show_progress=show_progress,
+            console=console,
+        )
 
 
 def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeRecord]) -> int:
@@ -289,8 +305,9 @@ def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeR
         try:
             redraw_map(spec, record, out_dir)
         except Exception as e:  # noqa: BLE001 - a picture that cannot be redrawn must not stop the run
-            Console(stderr=True).print(f"cannot redraw {out_dir / MAP_FILE}: {type(e).__name__}: {e}",
-                                       markup=False, highlight=False)
+            Console(stderr=True).print(
+                f"cannot redraw {out_dir / MAP_FILE}: {type(e).__name__}: {e}", markup=False, highlight=False
+            )
             continue
         redrawn += 1
     return redrawn

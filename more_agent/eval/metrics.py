@@ -95,7 +95,9 @@ class MetricSummary(FrozenModel):
     SR: Estimate
     TTC: Estimate
     TP: Estimate
-    rTP: Estimate | None = Field(description="None when no episode of the group has an rTP (none saw a goal condition).")
+    rTP: Estimate | None = Field(
+        description="None when no episode of the group has an rTP (none saw a goal condition)."
+    )
 
 
 def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
@@ -150,9 +152,7 @@ def system_label(record: EpisodeRecord) -> str:
     return f"{record.planner} ({record.llm})" if record.llm else record.planner
 
 
-def group_by(
-    records: Iterable[EpisodeRecord], key: Callable[[EpisodeRecord], str]
-) -> dict[str, list[EpisodeRecord]]:
+def group_by(records: Iterable[EpisodeRecord], key: Callable[[EpisodeRecord], str]) -> dict[str, list[EpisodeRecord]]:
     """Records grouped by ``key``, groups in sorted key order, records in input order."""
     groups: dict[str, list[EpisodeRecord]] = {}
     for r in records:

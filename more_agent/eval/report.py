@@ -103,26 +103,31 @@ def failure_markdown(records: Sequence[EpisodeRecord]) -> str:
     counts = {k: cause_counts(v) for k, v in groups.items()}
     causes = [c for c in CAUSE_ORDER if any(c in n for n in counts.values())]
     header = ["System", "n", "failures", *causes]
-    rows = [[k, str(len(groups[k])), str(sum(n.values())), *(str(n.get(c, 0)) for c in causes)] for k, n in counts.items()]
+    rows = [
+        [k, str(len(groups[k])), str(sum(n.values())), *(str(n.get(c, 0)) for c in causes)] for k, n in counts.items()
+    ]
     return _md_table(header, rows)
 
 
 def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluation summary") -> str:
     """The whole summary.md: Table I, notes on the metrics, the per-task table."""
-    return "\n\n".join(
-        [
-            f"# {md_text(title)}",
-            table_i_markdown(records),
-            "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
-            "rTP. Episodes are weighted equally; errored episodes count as failures. rTP counts the goal "
-            "conditions that name an observed task object; an episode that observed none has no rTP and "
-            "leaves its mean (its n is then given).",
-            "## Failure causes",
-            failure_markdown(records),
-            "## Per task",
-            per_task_markdown(records),
-        ]
-    ) + "\n"
+    return (
+        "\n\n".join(
+            [
+                f"# {md_text(title)}",
+                table_i_markdown(records),
+                "Means in percent with 95% intervals: Wilson for SR and TTC, percentile bootstrap for TP and "
+                "rTP. Episodes are weighted equally; errored episodes count as failures. rTP counts the goal "
+                "conditions that name an observed task object; an episode that observed none has no rTP and "
+                "leaves its mean (its n is then given).",
+                "## Failure causes",
+                failure_markdown(records),
+                "## Per task",
+                per_task_markdown(records),
+            ]
+        )
+        + "\n"
+    )
 
 
 def _csv_cells(e: Estimate | None) -> list[str]:
@@ -135,8 +140,17 @@ def summary_csv(records: Sequence[EpisodeRecord]) -> str:
     episodes that have an rTP (empty rTP cells when none has)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["system", "task", "n", "n_tasks", "n_errors", *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high")),
-                "n_rTP"])
+    w.writerow(
+        [
+            "system",
+            "task",
+            "n",
+            "n_tasks",
+            "n_errors",
+            *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high")),
+            "n_rTP",
+        ]
+    )
     rows = [((k, ALL_TASKS), s) for k, s in by_system(records).items()] + list(by_task(records).items())
     for (system, task), s in rows:
         cells = [c for m in METRIC_NAMES for c in _csv_cells(getattr(s, m))]

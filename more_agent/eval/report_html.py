@@ -39,8 +39,10 @@ def episode_file(record: EpisodeRecord, run_dir: Path, name: str) -> Path | None
     """A file of the episode's folder under ``run_dir/episodes/``, looked up by resolved scene then 'auto'
     (and in the folders of runs written before the LLM, start and distractors were part of the name)."""
     for scene in (record.scene or None, None):
-        for folder in (episode_dir(run_dir, record, scene or "auto"),
-                       Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner)):
+        for folder in (
+            episode_dir(run_dir, record, scene or "auto"),
+            Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner),
+        ):
             if (folder / name).is_file():
                 return folder / name
     return None
@@ -120,7 +122,7 @@ def episode_html(r: EpisodeRecord, run_dir: Path, base: Path) -> str:
         for c in r.goal_conditions
     )
     acts = "".join(
-        f'<tr><td>{a.step}</td><td>{escape(a.name)}</td><td>{escape(", ".join(a.arguments))}</td>'
+        f"<tr><td>{a.step}</td><td>{escape(a.name)}</td><td>{escape(', '.join(a.arguments))}</td>"
         f'<td class="{"ok" if a.ok else "fail"}">{"ok" if a.ok else "failed"}</td><td>{escape(a.feedback)}</td>'
         f"<td>{a.low_level_steps}</td></tr>"
         for a in r.actions
@@ -134,7 +136,7 @@ def episode_html(r: EpisodeRecord, run_dir: Path, base: Path) -> str:
     if r.error is not None:
         err = f'<p class="err">{escape(r.error)}</p>' + (f"<pre>{escape(r.traceback)}</pre>" if r.traceback else "")
     return (
-        f"<details><summary>{head}</summary><div class=\"ep\"><div>{thumbnail_html(r, run_dir, base)}</div><div>"
+        f'<details><summary>{head}</summary><div class="ep"><div>{thumbnail_html(r, run_dir, base)}</div><div>'
         f"<p>{escape(r.description)}</p>{err}<p>{usage}</p><ul>{conds}</ul>"
         f"<table><tr><th>step</th><th>action</th><th>arguments</th><th>result</th><th>feedback</th>"
         f"<th>low-level</th></tr>{acts}</table></div></div></details>"
@@ -149,7 +151,10 @@ def plots_html(plots: Sequence[Path], base: Path) -> str:
 
 
 def render_report(
-    sourced: Sequence[SourcedRecord], *, title: str = "Evaluation report", out_dir: Path | None = None,
+    sourced: Sequence[SourcedRecord],
+    *,
+    title: str = "Evaluation report",
+    out_dir: Path | None = None,
     plots: Sequence[Path] = (),
 ) -> str:
     """The whole HTML document, to be written into ``out_dir`` (links are relative to it; default the
@@ -162,9 +167,9 @@ def render_report(
     tasks = _summary_table([([k, t], s) for (k, t), s in by_task(records).items()], ["System", "Task"])
     episodes = "\n".join(episode_html(s.record, s.run_dir, base) for s in sourced)
     return (
-        f"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{escape(title)}</title>"
+        f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{escape(title)}</title>'
         f"<style>{_STYLE}</style></head><body><h1>{escape(title)}</h1>"
         f"<p>{len(records)} episodes, {calls} LLM calls, ${cost:.2f}. Means in percent with 95% intervals "
-        f"(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}<div class=\"plots\">{plots_html(plots, base)}</div>"
+        f'(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}<div class="plots">{plots_html(plots, base)}</div>'
         f"<details><summary>Per task</summary>{tasks}</details><h2>Episodes</h2>\n{episodes}\n</body></html>\n"
     )

@@ -53,7 +53,9 @@ def plot_metrics(records: Sequence[EpisodeRecord], path: Path) -> Path:
     """One panel per metric: a bar per system at its mean with the 95% interval as error bar."""
     systems = by_system(records)
     names = list(systems)
-    fig, axes = plt.subplots(2, 2, figsize=(9, 2 * (0.9 + 0.4 * len(names)) + 0.6), sharey=True, constrained_layout=True)
+    fig, axes = plt.subplots(
+        2, 2, figsize=(9, 2 * (0.9 + 0.4 * len(names)) + 0.6), sharey=True, constrained_layout=True
+    )
     y = np.arange(len(names))
     for ax, metric in zip(axes.flat, METRIC_NAMES):
         est = [getattr(systems[n], metric) or NO_ESTIMATE for n in names]
@@ -97,14 +99,18 @@ def plot_distributions(records: Sequence[EpisodeRecord], path: Path) -> Path:
     names = list(groups)
     series = {
         "high-level steps per episode": [[r.high_level_steps for r in groups[n]] for n in names],
-        "LLM tokens per episode": [[r.llm_usage.prompt_tokens + r.llm_usage.completion_tokens for r in groups[n]] for n in names],
+        "LLM tokens per episode": [
+            [r.llm_usage.prompt_tokens + r.llm_usage.completion_tokens for r in groups[n]] for n in names
+        ],
     }
     fig, axes = plt.subplots(1, 2, figsize=(max(8.0, 2.0 + 2.2 * len(names)), 4.2))
     rng = np.random.default_rng(0)
     for ax, (title, data) in zip(axes, series.items()):
         ax.boxplot(data, positions=range(len(names)), widths=0.5, showfliers=False)
         for i, values in enumerate(data):
-            ax.scatter(i + rng.uniform(-0.18, 0.18, len(values)), values, s=8, alpha=0.5, color=_COLOURS(i % 10), zorder=3)
+            ax.scatter(
+                i + rng.uniform(-0.18, 0.18, len(values)), values, s=8, alpha=0.5, color=_COLOURS(i % 10), zorder=3
+            )
         ax.set_title(title, fontsize=10)
         ax.grid(axis="y", alpha=0.3)
         ax.set_xticks(range(len(names)), names, fontsize=8, rotation=20, ha="right")
@@ -136,12 +142,16 @@ def plot_failures(records: Sequence[EpisodeRecord], path: Path) -> Path:
         widths = np.array([counts[n][reason] for n in names], dtype=float)
         ax.barh(range(len(names)), widths, left=left, color=cmap(k % 20), label=reason)
         left += widths
-    ax.set_yticks(range(len(names)), [f"{n} ({int(left[i])} of {len(groups[n])})" for i, n in enumerate(names)], fontsize=8)
+    ax.set_yticks(
+        range(len(names)), [f"{n} ({int(left[i])} of {len(groups[n])})" for i, n in enumerate(names)], fontsize=8
+    )
     ax.invert_yaxis()
     ax.set_xlabel("unsuccessful episodes")
     ax.set_title("Failure reasons per system" + ("" if reasons else ": no failures"), fontsize=10)
     if reasons:
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.25 - 0.1 * len(names) / 4), ncol=2, frameon=False)
+        ax.legend(
+            fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.25 - 0.1 * len(names) / 4), ncol=2, frameon=False
+        )
     return _save(fig, path)
 
 

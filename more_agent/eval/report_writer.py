@@ -24,4 +24,3 @@ def write_reports(sourced: Sequence[SourcedRecord], out_dir: Path, *, title: str
     write_atomic(paths[1], summary_csv(records))
     write_atomic(paths[2], render_report(sourced, title=title, out_dir=out_dir, plots=plots))
     return paths + plots
-

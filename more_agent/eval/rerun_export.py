@@ -77,8 +77,13 @@ def write_rerun(episode_dir: Path, out: Path) -> RerunSummary:
             rec.log("world/robot", rr.Points3D([(*path[-1], 0.05)], radii=0.15, labels=["robot"]))
         graphs += _log_graph(rr, rec, folder, action.step)
         status = "success" if action.ok else "failure"
-        rec.log("action", rr.TextLog(f"step {action.step}: {action.name}({', '.join(action.arguments)}) -> {status}; "
-                                     f"{action.feedback}", level="INFO" if action.ok else "WARN"))
+        rec.log(
+            "action",
+            rr.TextLog(
+                f"step {action.step}: {action.name}({', '.join(action.arguments)}) -> {status}; {action.feedback}",
+                level="INFO" if action.ok else "WARN",
+            ),
+        )
     rec.flush()
     return RerunSummary(path=Path(out), steps=len(record.actions), frames=frames, graphs=graphs)
 
@@ -104,18 +109,29 @@ def _log_graph(rr: Any, rec: Any, folder: EpisodeFolder, step: int) -> int:
     objects = list(g["objects"].values())
     lo = np.array([o["bbox"]["min"] for o in objects]).reshape(-1, 3)
     hi = np.array([o["bbox"]["max"] for o in objects]).reshape(-1, 3)
-    rec.log("world/graph/objects", rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                              labels=[o["label"] for o in objects]))
+    rec.log(
+        "world/graph/objects",
+        rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, labels=[o["label"] for o in objects]),
+    )
     regions = sorted(g["regions"].values(), key=lambda r: r["id"])
     centroid = {r["id"]: (*r["centroid"], 0.0) for r in regions}
-    rec.log("world/graph/regions", rr.Points3D([centroid[r["id"]] for r in regions], radii=0.2,
-                                               labels=[r["room_label"] or r["id"] for r in regions]))
+    rec.log(
+        "world/graph/regions",
+        rr.Points3D(
+            [centroid[r["id"]] for r in regions], radii=0.2, labels=[r["room_label"] or r["id"] for r in regions]
+        ),
+    )
     nodes = np.array(g["nav"]["node_xy"], dtype=float).reshape(-1, 2)
     rec.log("world/graph/places", rr.Points3D(np.c_[nodes, np.zeros(len(nodes))], radii=0.05))
-    rec.log("world/graph/nav_edges", rr.LineStrips3D([[(*nodes[a], 0.0), (*nodes[b], 0.0)]
-                                                      for a, b in g["nav"]["edges"]]))
-    rec.log("world/graph/edges", rr.LineStrips3D([[centroid[o["region_id"]], tuple(o["position"])]
-                                                  for o in objects if o["region_id"] in centroid]))
+    rec.log(
+        "world/graph/nav_edges", rr.LineStrips3D([[(*nodes[a], 0.0), (*nodes[b], 0.0)] for a, b in g["nav"]["edges"]])
+    )
+    rec.log(
+        "world/graph/edges",
+        rr.LineStrips3D(
+            [[centroid[o["region_id"]], tuple(o["position"])] for o in objects if o["region_id"] in centroid]
+        ),
+    )
     occupancy = folder.graph_path(step, "_occupancy.png")
     if occupancy.is_file():
         rec.log("world/map", _voxels(rr, occupancy))
@@ -129,5 +145,6 @@ def _voxels(rr: Any, path: Path) -> Any:
         cells = np.asarray(im).T  # the file's rows run along y: back to grid[ix, iy]
     xy = Grid(origin_xy=tuple(origin), resolution_m=res).xy_of(np.argwhere(cells == OCCUPIED))
     centres = np.c_[xy, np.full(len(xy), WALL_HEIGHT_M / 2)]
-    return rr.Boxes3D(centers=centres, half_sizes=np.tile([res / 2, res / 2, WALL_HEIGHT_M / 2], (len(xy), 1)),
-                      colors=[(90, 90, 90)])
+    return rr.Boxes3D(
+        centers=centres, half_sizes=np.tile([res / 2, res / 2, WALL_HEIGHT_M / 2], (len(xy), 1)), colors=[(90, 90, 90)]
+    )

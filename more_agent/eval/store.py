@@ -49,8 +49,12 @@ class RunConfig(BaseModel):
     tasks: list[str] = Field(default_factory=list, description="Task names, in run order.")
     seeds: list[int] = Field(default_factory=list, description="Seeds run for every task.")
     scene: str | None = Field(default=None, description="Scene for every task; None lets each episode pick.")
-    start: str = Field(default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'.")
-    distractors: bool = Field(default=True, description="Whether every episode's world holds the scene's own small objects.")
+    start: str = Field(
+        default="random", description="Robot start of every episode: 'random', 'random-area' or 'task-room'."
+    )
+    distractors: bool = Field(
+        default=True, description="Whether every episode's world holds the scene's own small objects."
+    )
     descriptions: str = Field(
         default="named", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions)."
     )
@@ -66,7 +70,16 @@ class RunConfig(BaseModel):
 
 
 MIXING_FIELDS = (
-    "planner", "llm", "tasks", "seeds", "scene", "start", "distractors", "descriptions", "history", "episode_fn",
+    "planner",
+    "llm",
+    "tasks",
+    "seeds",
+    "scene",
+    "start",
+    "distractors",
+    "descriptions",
+    "history",
+    "episode_fn",
 )
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
@@ -84,15 +97,17 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     starts = sorted({r.start for r in records})
     histories = sorted({r.history for r in records})
     descriptions = sorted({r.descriptions for r in records})
-    return config.model_copy(update={
-        "start": starts[0] if len(starts) == 1 else ",".join(starts),
-        "history": histories[0] if len(histories) == 1 else ",".join(histories),
-        "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
-        "planner": planners[0] if len(planners) == 1 else ",".join(planners),
-        "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
-        "tasks": sorted({r.task for r in records} | set(config.tasks)),
-        "seeds": sorted({r.seed for r in records} | set(config.seeds)),
-    })
+    return config.model_copy(
+        update={
+            "start": starts[0] if len(starts) == 1 else ",".join(starts),
+            "history": histories[0] if len(histories) == 1 else ",".join(histories),
+            "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
+            "planner": planners[0] if len(planners) == 1 else ",".join(planners),
+            "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
+            "tasks": sorted({r.task for r in records} | set(config.tasks)),
+            "seeds": sorted({r.seed for r in records} | set(config.seeds)),
+        }
+    )
 
 
 def check_same_run(run_dir: Path, old: RunConfig, new: RunConfig) -> None:
@@ -234,8 +249,7 @@ def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[Epis
     out = []
     for s in specs:
         key = (s.task, s.seed, s.planner, s.llm, s.start, s.descriptions, s.history)
-        scenes = {r.scene for r in done.get(key, [])
-                  if r.distractors in (None, s.distractors)}
+        scenes = {r.scene for r in done.get(key, []) if r.distractors in (None, s.distractors)}
         if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
     return out
@@ -255,8 +269,15 @@ def _scene_name(scene: str) -> str:
 
 
 def episode_dirname(
-    task: str, scene: str | None, seed: int, planner: str, *,
-    llm: str | None = None, start: str = "random", distractors: bool | None = True, descriptions: str = "named",
+    task: str,
+    scene: str | None,
+    seed: int,
+    planner: str,
+    *,
+    llm: str | None = None,
+    start: str = "random",
+    distractors: bool | None = True,
+    descriptions: str = "named",
     history: str = "paper",
 ) -> str:
     """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
@@ -281,9 +302,17 @@ def episode_dirname(
 
 def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str | None = None) -> Path:
     """The folder of ``episode``'s files in the run folder ``run_dir`` (``scene`` in place of its own)."""
-    name = episode_dirname(episode.task, scene if scene is not None else episode.scene, episode.seed, episode.planner,
-                           llm=episode.llm, start=episode.start, distractors=episode.distractors,
-                           descriptions=episode.descriptions, history=episode.history)
+    name = episode_dirname(
+        episode.task,
+        scene if scene is not None else episode.scene,
+        episode.seed,
+        episode.planner,
+        llm=episode.llm,
+        start=episode.start,
+        distractors=episode.distractors,
+        descriptions=episode.descriptions,
+        history=episode.history,
+    )
     return Path(run_dir) / EPISODE_DIRS / name
 
 

@@ -55,7 +55,10 @@ def _data_uri(image: Image.Image, fmt: str) -> str:
 def _frame_uris(folder: EpisodeFolder, index: int) -> dict[str, str] | None:
     """One frame's RGB (JPEG) and semantic (PNG) pictures, downscaled, as data URIs; None if missing."""
     out = {}
-    for kind, fmt, resample in (("rgb", "JPEG", Image.Resampling.BILINEAR), ("semantic", "PNG", Image.Resampling.NEAREST)):
+    for kind, fmt, resample in (
+        ("rgb", "JPEG", Image.Resampling.BILINEAR),
+        ("semantic", "PNG", Image.Resampling.NEAREST),
+    ):
         path = folder.frame_path(index, kind)
         if not path.is_file():
             return None
@@ -102,12 +105,20 @@ def _map(folder: EpisodeFolder, step: int) -> dict[str, Any] | None:
         "doors": nav["door_edges"],
         "node_region": nav["node_region"],
         "regions": [
-            {"id": r["id"], "label": r["room_label"], "frontiers": [[round(x, 2), round(y, 2)] for x, y in r["frontiers"]]}
+            {
+                "id": r["id"],
+                "label": r["room_label"],
+                "frontiers": [[round(x, 2), round(y, 2)] for x, y in r["frontiers"]],
+            }
             for r in regions
         ],
         "objects": [
-            {"label": o["label"], "door": o["category"] == "door", "held": o["held"],
-             "box": [round(v, 2) for v in (*o["bbox"]["min"][:2], *o["bbox"]["max"][:2])]}
+            {
+                "label": o["label"],
+                "door": o["category"] == "door",
+                "held": o["held"],
+                "box": [round(v, 2) for v in (*o["bbox"]["min"][:2], *o["bbox"]["max"][:2])],
+            }
             for o in g["objects"].values()
         ],
         "robot": [round(v, 2) for v in g["robot"]["position"]],
@@ -177,11 +188,15 @@ def _with_thumbnails(exchange: dict[str, Any]) -> dict[str, Any]:
     messages = []
     for m in exchange["messages"]:
         if isinstance(m.get("content"), list):
-            m = {**m, "content": [
-                {**p, "image_url": {"url": _thumbnail(p.get("image_url", {}).get("url", ""))}}
-                if p.get("type") == "image_url" else p
-                for p in m["content"]
-            ]}
+            m = {
+                **m,
+                "content": [
+                    {**p, "image_url": {"url": _thumbnail(p.get("image_url", {}).get("url", ""))}}
+                    if p.get("type") == "image_url"
+                    else p
+                    for p in m["content"]
+                ],
+            }
         messages.append(m)
     return {**exchange, "messages": messages}
 
@@ -219,13 +234,20 @@ def viewer_data(episode_dir: Path) -> dict[str, Any]:
         end_frame = t.get("frames", first_frame)
         picks = step_frame_indices(first_frame, end_frame)
         frames = [{"index": i, **f} for i in picks if (f := _frame_uris(folder, i))]
-        steps.append({
-            "step": action.step, "action": action.model_dump(), "frames": frames,
-            "frame_range": [first_frame, end_frame],
-            "goals": t.get("goals"), "progress": t.get("progress"), "path_len": t.get("path_len"),
-            "targets": t.get("targets", []), "map": _map(folder, action.step),
-            **_llm_step(llm_steps.get(action.step)),
-        })
+        steps.append(
+            {
+                "step": action.step,
+                "action": action.model_dump(),
+                "frames": frames,
+                "frame_range": [first_frame, end_frame],
+                "goals": t.get("goals"),
+                "progress": t.get("progress"),
+                "path_len": t.get("path_len"),
+                "targets": t.get("targets", []),
+                "map": _map(folder, action.step),
+                **_llm_step(llm_steps.get(action.step)),
+            }
+        )
         first_frame = end_frame
     return {
         "record": record.model_dump(exclude={"actions", "trajectory", "traceback"}),
@@ -257,7 +279,9 @@ def write_viewer(episode_dir: Path, out: Path | None = None) -> Path:
     try:
         data = viewer_data(Path(episode_dir))
     except (KeyError, TypeError, IndexError) as e:
-        raise UserError(f"{episode_dir}: a step file holds a line this version cannot read ({type(e).__name__}: {e})") from None
+        raise UserError(
+            f"{episode_dir}: a step file holds a line this version cannot read ({type(e).__name__}: {e})"
+        ) from None
     return EpisodeFolder(Path(episode_dir)).write_viewer(render_viewer(data), out)
 
 

@@ -55,8 +55,12 @@ class BagTopics(BaseModel):
     labels: str = Field("/more/labels", description="Label table topic (std_msgs/String, JSON LabelTable).")
     pose: str | None = Field(None, description="PoseStamped of the camera's optical frame in world_frame; None: /tf.")
     world_frame: str = Field("map", description="Fixed frame the map is built in.")
-    camera_frame: str | None = Field(None, description="Optical frame of the depth camera; None: the depth header's frame_id.")
-    base_frame: str = Field("base_link", description="Robot base frame (its x, y is the robot's position); the camera's when absent.")
+    camera_frame: str | None = Field(
+        None, description="Optical frame of the depth camera; None: the depth header's frame_id."
+    )
+    base_frame: str = Field(
+        "base_link", description="Robot base frame (its x, y is the robot's position); the camera's when absent."
+    )
 
 
 class InstanceLabel(BaseModel):
@@ -65,11 +69,14 @@ class InstanceLabel(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     category: str = Field(description="Object class, e.g. 'fridge'; 'door' for doors.")
-    label: str | None = Field(None, description="Instance label such as 'fridge A'; None: given in order of first observation.")
+    label: str | None = Field(
+        None, description="Instance label such as 'fridge A'; None: given in order of first observation."
+    )
     open: bool | None = Field(None, description="Open state of an openable object; None otherwise.")
     held: bool = Field(False, description="True while the robot holds it.")
     rests: tuple[Literal["inside", "ontop"], str | None] | None = Field(
-        None, description="How it rests ('inside' | 'ontop', label of its support, None for the floor); None: from geometry."
+        None,
+        description="How it rests ('inside' | 'ontop', label of its support, None for the floor); None: from geometry.",
     )
 
 
@@ -96,8 +103,10 @@ def image_array(msg: Any, topic: str, encodings: tuple[str, ...] | dict[str, Any
     channels = _CHANNELS.get(msg.encoding, 1)
     row = msg.width * channels * dtype.itemsize
     if msg.step < row or len(msg.data) < msg.step * msg.height:
-        raise BagError(f"topic {topic}: {len(msg.data)} bytes of data do not hold a {msg.width}x{msg.height} "
-                       f"{msg.encoding} image with step {msg.step}")
+        raise BagError(
+            f"topic {topic}: {len(msg.data)} bytes of data do not hold a {msg.width}x{msg.height} "
+            f"{msg.encoding} image with step {msg.step}"
+        )
     rows = np.frombuffer(np.asarray(msg.data, dtype=np.uint8).tobytes(), dtype=np.uint8)
     rows = rows[: msg.step * msg.height].reshape(msg.height, msg.step)[:, :row]
     pixels = np.ascontiguousarray(rows).view(dtype).astype(dtype.newbyteorder("="))
@@ -106,14 +115,20 @@ def image_array(msg: Any, topic: str, encodings: tuple[str, ...] | dict[str, Any
 
 def id_encoding(ids: np.ndarray) -> str:
     """The narrowest contract encoding for an id image: 16UC1 while ids fit, else 32SC1."""
-    return "16UC1" if ids.size == 0 or (ids.min() >= 0 and ids.max() < 2 ** 16) else "32SC1"
+    return "16UC1" if ids.size == 0 or (ids.min() >= 0 and ids.max() < 2**16) else "32SC1"
 
 
 def image_fields(pixels: np.ndarray, encoding: str) -> dict[str, Any]:
     """``height``, ``width``, ``encoding``, ``is_bigendian``, ``step`` and ``data`` of an Image message."""
     data = np.ascontiguousarray(pixels.astype(np.dtype(_DTYPES[encoding]).newbyteorder("<")))
-    return {"height": data.shape[0], "width": data.shape[1], "encoding": encoding, "is_bigendian": 0,
-            "step": data.shape[1] * _CHANNELS.get(encoding, 1) * data.itemsize, "data": data.view(np.uint8).ravel()}
+    return {
+        "height": data.shape[0],
+        "width": data.shape[1],
+        "encoding": encoding,
+        "is_bigendian": 0,
+        "step": data.shape[1] * _CHANNELS.get(encoding, 1) * data.itemsize,
+        "data": data.view(np.uint8).ravel(),
+    }
 
 
 def typestore() -> Any:

@@ -95,9 +95,14 @@ class BagStream:
             raise BagError(f"cannot read the bag {self.path}: {type(e).__name__}: {e}") from None
         self._conns = {c.topic: c for c in self._reader.connections}
         t = self.topics
-        self._images = {role: self._connection(topic, IMAGE, role, option) for role, topic, option in (
-            ("depth", t.depth, "--depth-topic"), ("semantic", t.semantic, "--semantic-topic"),
-            ("instance", t.instance, "--instance-topic"))}
+        self._images = {
+            role: self._connection(topic, IMAGE, role, option)
+            for role, topic, option in (
+                ("depth", t.depth, "--depth-topic"),
+                ("semantic", t.semantic, "--semantic-topic"),
+                ("instance", t.instance, "--instance-topic"),
+            )
+        }
         if t.rgb in self._conns:
             self._images["rgb"] = self._connection(t.rgb, IMAGE, "colour", "--rgb-topic")
         self._info = self._stamped(self._connection(t.camera_info, CAMERA_INFO, "camera info", "--camera-info-topic"))
@@ -106,7 +111,9 @@ class BagStream:
         self.class_names = list(self._tables.messages[0].classes)
         for table in self._tables.messages:
             if table.classes[: len(self.class_names)] != self.class_names:
-                raise BagError(f"topic {t.labels}: the class list changed within the bag (classes may only be appended)")
+                raise BagError(
+                    f"topic {t.labels}: the class list changed within the bag (classes may only be appended)"
+                )
         self._tf = self._transforms()
         self._last_table = -1
 
@@ -118,8 +125,10 @@ class BagStream:
         conn = self._conns.get(topic)
         if conn is None:
             have = ", ".join(f"{c.topic} ({c.msgtype})" for c in self._conns.values()) or "none"
-            raise BagError(f"the bag {self.path} has no topic {topic} (the {role} stream, {msgtype}); set {option}. "
-                           f"Topics in the bag: {have}")
+            raise BagError(
+                f"the bag {self.path} has no topic {topic} (the {role} stream, {msgtype}); set {option}. "
+                f"Topics in the bag: {have}"
+            )
         if conn.msgtype != msgtype:
             raise BagError(f"topic {topic} (the {role} stream) holds {conn.msgtype}, expected {msgtype}")
         return conn
@@ -139,7 +148,9 @@ class BagStream:
         try:
             return LabelTable.model_validate(json.loads(text))
         except (json.JSONDecodeError, ValidationError) as e:
-            raise BagError(f"topic {self.topics.labels}: not a label table (docs/ros.md): {str(e).splitlines()[0]}") from None
+            raise BagError(
+                f"topic {self.topics.labels}: not a label table (docs/ros.md): {str(e).splitlines()[0]}"
+            ) from None
 
     def _transforms(self) -> TransformBuffer:
         tf = TransformBuffer()
@@ -147,9 +158,13 @@ class BagStream:
         if t.pose is not None:
             for msg in self._stamped(self._connection(t.pose, POSE, "pose", "--pose-topic")).messages:
                 p = msg.pose
-                tf.add(msg.header.frame_id, t.pose, _seconds(msg.header.stamp),
-                       (p.position.x, p.position.y, p.position.z),
-                       (p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w))
+                tf.add(
+                    msg.header.frame_id,
+                    t.pose,
+                    _seconds(msg.header.stamp),
+                    (p.position.x, p.position.y, p.position.z),
+                    (p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w),
+                )
             return tf
         conns = [self._connection(TF_TOPIC, TF, "transforms", "--pose-topic")]
         if TF_STATIC_TOPIC in self._conns:
@@ -157,8 +172,14 @@ class BagStream:
         for conn, _, raw in self._reader.messages(connections=conns):
             for tr in self._store.deserialize_cdr(raw, conn.msgtype).transforms:
                 q, v = tr.transform.rotation, tr.transform.translation
-                tf.add(tr.header.frame_id, tr.child_frame_id, _seconds(tr.header.stamp), (v.x, v.y, v.z),
-                       (q.x, q.y, q.z, q.w), static=conn.topic == TF_STATIC_TOPIC)
+                tf.add(
+                    tr.header.frame_id,
+                    tr.child_frame_id,
+                    _seconds(tr.header.stamp),
+                    (v.x, v.y, v.z),
+                    (q.x, q.y, q.z, q.w),
+                    static=conn.topic == TF_STATIC_TOPIC,
+                )
         return tf
 
     def _camera_frame(self, depth_msg: Any) -> str:
@@ -174,7 +195,7 @@ class BagStream:
         count = 0
         for conn, t_ns, raw in self._reader.messages(connections=list(self._images.values())):
             msg = self._store.deserialize_cdr(raw, conn.msgtype)
-            stamp = msg.header.stamp.sec * 10 ** 9 + msg.header.stamp.nanosec
+            stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
             parts = pending.setdefault(stamp, {})
             parts[roles[conn.id]] = (t_ns, msg)
             if len(parts) == len(self._images):
@@ -188,9 +209,12 @@ class BagStream:
         if count == 0:
             seen = {role for parts in pending.values() for role in parts}
             missing = [self._images[r].topic for r in self._images if r not in seen] or [
-                c.topic for c in self._images.values()]
-            raise BagError(f"no complete frame in {self.path}: no image on {', '.join(missing)} shares a "
-                           "header.stamp with the other image topics")
+                c.topic for c in self._images.values()
+            ]
+            raise BagError(
+                f"no complete frame in {self.path}: no image on {', '.join(missing)} shares a "
+                "header.stamp with the other image topics"
+            )
 
     def _frame(self, parts: dict[str, tuple[int, Any]]) -> SensorFrame:
         t = self.topics
@@ -209,23 +233,35 @@ class BagStream:
             rgb = rgb[..., ::-1].copy() if RGB_ENCODINGS[msg.encoding] else rgb
         for topic, img in ((t.semantic, semantic), (t.instance, instance), (t.rgb, rgb)):
             if img is not None and img.shape[:2] != depth.shape:
-                raise BagError(f"topic {topic}: a {img.shape[1]}x{img.shape[0]} image for a "
-                               f"{depth.shape[1]}x{depth.shape[0]} depth image")
+                raise BagError(
+                    f"topic {topic}: a {img.shape[1]}x{img.shape[0]} image for a "
+                    f"{depth.shape[1]}x{depth.shape[0]} depth image"
+                )
         info = self._info.at(t_ns)[1]
         if (info.width, info.height) != (depth.shape[1], depth.shape[0]):
-            raise BagError(f"topic {t.camera_info}: camera info for {info.width}x{info.height}, depth images are "
-                           f"{depth.shape[1]}x{depth.shape[0]}")
+            raise BagError(
+                f"topic {t.camera_info}: camera info for {info.width}x{info.height}, depth images are "
+                f"{depth.shape[1]}x{depth.shape[0]}"
+            )
         stamp_s = _seconds(depth_msg.header.stamp)
         T_world_cam = self._tf.lookup(t.world_frame, self._camera_frame(depth_msg), stamp_s)
-        robot = (self._tf.lookup(t.world_frame, t.base_frame, stamp_s) if self._tf.knows(t.base_frame)
-                 else T_world_cam)[:2, 3]
+        robot = (
+            self._tf.lookup(t.world_frame, t.base_frame, stamp_s) if self._tf.knows(t.base_frame) else T_world_cam
+        )[:2, 3]
         index, table = self._tables.at(t_ns)
         placed = table.placed if index != self._last_table else {}
         self._last_table = index
         return SensorFrame(
-            stamp_s=stamp_s, depth=depth, semantic=semantic, instance=instance, rgb=rgb,
-            K=np.asarray(info.k, dtype=float).reshape(3, 3), T_world_cam=T_world_cam,
-            robot_xy=(float(robot[0]), float(robot[1])), instances=dict(table.instances), placed=dict(placed),
+            stamp_s=stamp_s,
+            depth=depth,
+            semantic=semantic,
+            instance=instance,
+            rgb=rgb,
+            K=np.asarray(info.k, dtype=float).reshape(3, 3),
+            T_world_cam=T_world_cam,
+            robot_xy=(float(robot[0]), float(robot[1])),
+            instances=dict(table.instances),
+            placed=dict(placed),
         )
 
 

@@ -68,9 +68,17 @@ class BagRecorder:
     def __enter__(self) -> BagRecorder:
         self._writer.open()
         t = self.topics
-        for topic, msgtype in ((t.depth, IMAGE), (t.rgb, IMAGE), (t.semantic, IMAGE), (t.instance, IMAGE),
-                               (t.camera_info, CAMERA_INFO), (TF_TOPIC, TF), (TF_STATIC_TOPIC, TF),
-                               (POSE_TOPIC, POSE), (t.labels, STRING)):
+        for topic, msgtype in (
+            (t.depth, IMAGE),
+            (t.rgb, IMAGE),
+            (t.semantic, IMAGE),
+            (t.instance, IMAGE),
+            (t.camera_info, CAMERA_INFO),
+            (TF_TOPIC, TF),
+            (TF_STATIC_TOPIC, TF),
+            (POSE_TOPIC, POSE),
+            (t.labels, STRING),
+        ):
             self._conns[topic] = self._writer.add_connection(topic, msgtype, typestore=self._store)
         return self
 
@@ -82,8 +90,9 @@ class BagRecorder:
         t = self.topics
         t_ns = round(self.frames * FRAME_PERIOD_S * 1e9)
         header = self._header(t_ns, CAMERA_FRAME)
-        T_world_base = pose_matrix((world.robot.x, world.robot.y, 0.0), (0.0, 0.0, np.sin(world.robot.yaw / 2),
-                                                                           np.cos(world.robot.yaw / 2)))
+        T_world_base = pose_matrix(
+            (world.robot.x, world.robot.y, 0.0), (0.0, 0.0, np.sin(world.robot.yaw / 2), np.cos(world.robot.yaw / 2))
+        )
         if self.frames == 0:
             T_base_cam = np.linalg.inv(T_world_base) @ frame.T_world_cam
             self._write(TF_STATIC_TOPIC, t_ns, self._tf(t_ns, t.base_frame, CAMERA_FRAME, T_base_cam))
@@ -91,12 +100,24 @@ class BagRecorder:
         self._write(TF_TOPIC, t_ns, self._tf(t_ns, t.world_frame, t.base_frame, T_world_base))
         position, q = matrix_pose(frame.T_world_cam)
         types = self._store.types
-        self._write(POSE_TOPIC, t_ns, self._msg(POSE, header=self._header(t_ns, t.world_frame), pose=types[
-            "geometry_msgs/msg/Pose"](position=types["geometry_msgs/msg/Point"](*position), orientation=self._quat(q))))
+        self._write(
+            POSE_TOPIC,
+            t_ns,
+            self._msg(
+                POSE,
+                header=self._header(t_ns, t.world_frame),
+                pose=types["geometry_msgs/msg/Pose"](
+                    position=types["geometry_msgs/msg/Point"](*position), orientation=self._quat(q)
+                ),
+            ),
+        )
         self._write(t.camera_info, t_ns, self._camera_info(header, frame))
-        for topic, pixels, encoding in ((t.depth, frame.depth, "32FC1"), (t.rgb, frame.rgb, "rgb8"),
-                                        (t.semantic, frame.semantic, id_encoding(frame.semantic)),
-                                        (t.instance, frame.instance, id_encoding(frame.instance))):
+        for topic, pixels, encoding in (
+            (t.depth, frame.depth, "32FC1"),
+            (t.rgb, frame.rgb, "rgb8"),
+            (t.semantic, frame.semantic, id_encoding(frame.semantic)),
+            (t.instance, frame.instance, id_encoding(frame.instance)),
+        ):
             self._write(topic, t_ns, self._msg(IMAGE, header=header, **image_fields(pixels, encoding)))
         self.frames += 1
 
@@ -114,12 +135,18 @@ class BagRecorder:
     def _label_table(self, world: World, frame: Frame) -> LabelTable:
         """Instances in view, the held one, those whose open state changed out of view (the robot just
         opened / closed them) and the item just put down, with its box."""
-        entries = {iid: InstanceLabel(category=d["category"], label=d["label"], open=d["open"], held=d["held"],
-                                      rests=_rests(world, d["name"]))
-                   for iid, d in instance_table(world, frame.instance).items()}
+        entries = {
+            iid: InstanceLabel(
+                category=d["category"], label=d["label"], open=d["open"], held=d["held"], rests=_rests(world, d["name"])
+            )
+            for iid, d in instance_table(world, frame.instance).items()
+        }
         by_id = {o.instance_id: o for o in world.objects.values()}
-        changed = [iid for iid, was in self._reported_open.items()
-                   if iid not in entries and by_id[iid].openable and by_id[iid].is_open != was]
+        changed = [
+            iid
+            for iid, was in self._reported_open.items()
+            if iid not in entries and by_id[iid].openable and by_id[iid].is_open != was
+        ]
         released = self._held if self._held is not None and self._held != world.robot.held else None
         placed = {}
         if released is not None:
@@ -129,9 +156,16 @@ class BagRecorder:
             placed[obj.instance_id] = (tuple(map(float, lo)), tuple(map(float, hi)))
         for iid in changed:
             obj = by_id[iid]
-            entries.setdefault(iid, InstanceLabel(category=obj.category, label=obj.label,
-                                                  open=obj.is_open if obj.openable else None,
-                                                  held=world.robot.held == obj.name, rests=_rests(world, obj.name)))
+            entries.setdefault(
+                iid,
+                InstanceLabel(
+                    category=obj.category,
+                    label=obj.label,
+                    open=obj.is_open if obj.openable else None,
+                    held=world.robot.held == obj.name,
+                    rests=_rests(world, obj.name),
+                ),
+            )
         self._held = world.robot.held
         self._reported_open.update({iid: e.open for iid, e in entries.items()})
         return LabelTable(classes=list(world.class_names), instances=entries, placed=placed)
@@ -145,7 +179,7 @@ class BagRecorder:
 
     def _header(self, t_ns: int, frame_id: str) -> Any:
         types = self._store.types
-        stamp = types["builtin_interfaces/msg/Time"](sec=t_ns // 10 ** 9, nanosec=t_ns % 10 ** 9)
+        stamp = types["builtin_interfaces/msg/Time"](sec=t_ns // 10**9, nanosec=t_ns % 10**9)
         return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame_id)
 
     def _quat(self, q: np.ndarray) -> Any:
@@ -155,19 +189,33 @@ class BagRecorder:
         types = self._store.types
         translation, q = matrix_pose(T)
         transform = types["geometry_msgs/msg/Transform"](
-            translation=types["geometry_msgs/msg/Vector3"](*map(float, translation)), rotation=self._quat(q))
-        stamped = types["geometry_msgs/msg/TransformStamped"](header=self._header(t_ns, parent), child_frame_id=child,
-                                                              transform=transform)
+            translation=types["geometry_msgs/msg/Vector3"](*map(float, translation)), rotation=self._quat(q)
+        )
+        stamped = types["geometry_msgs/msg/TransformStamped"](
+            header=self._header(t_ns, parent), child_frame_id=child, transform=transform
+        )
         return self._msg(TF, transforms=[stamped])
 
     def _camera_info(self, header: Any, frame: Frame) -> Any:
         h, w = frame.depth.shape
         K = np.asarray(frame.K, dtype=np.float64)
-        roi = self._store.types["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0,
-                                                                      do_rectify=False)
-        return self._msg(CAMERA_INFO, header=header, height=h, width=w, distortion_model="plumb_bob", d=np.zeros(5),
-                         k=K.ravel(), r=np.eye(3).ravel(), p=np.hstack([K, np.zeros((3, 1))]).ravel(),
-                         binning_x=0, binning_y=0, roi=roi)
+        roi = self._store.types["sensor_msgs/msg/RegionOfInterest"](
+            x_offset=0, y_offset=0, height=0, width=0, do_rectify=False
+        )
+        return self._msg(
+            CAMERA_INFO,
+            header=header,
+            height=h,
+            width=w,
+            distortion_model="plumb_bob",
+            d=np.zeros(5),
+            k=K.ravel(),
+            r=np.eye(3).ravel(),
+            p=np.hstack([K, np.zeros((3, 1))]).ravel(),
+            binning_x=0,
+            binning_y=0,
+            roi=roi,
+        )
 
 
 def _rests(world: World, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:

@@ -51,8 +51,9 @@ class FrameMapper:
         for iid in np.unique(frame.instance[frame.instance > 0]).tolist():
             if iid not in infos and iid not in self._labels:
                 infos[iid] = self._info(iid, InstanceLabel(category=self._category(frame, iid)))
-        self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos,
-                               frame.robot_xy)
+        self.builder.integrate(
+            frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, frame.robot_xy
+        )
         if not self.path or self.path[-1] != frame.robot_xy:
             self.path.append(frame.robot_xy)
         self.frames += 1
@@ -107,5 +108,12 @@ def ingest_bag(path: Path, topics: BagTopics | None = None, config: MappingConfi
         built = time.perf_counter()
     finally:
         stream.close()
-    return IngestResult(graph=graph, class_names=mapper.class_names, frames=mapper.frames, skipped=stream.skipped,
-                        fuse_s=fused - t, build_s=built - fused, path=mapper.path)
+    return IngestResult(
+        graph=graph,
+        class_names=mapper.class_names,
+        frames=mapper.frames,
+        skipped=stream.skipped,
+        fuse_s=fused - t,
+        build_s=built - fused,
+        path=mapper.path,
+    )

@@ -68,16 +68,18 @@ def to_spark_dsg(graph: SceneGraph) -> Any:
         attrs.real_place = True
         attrs.metadata.set({KEY: {"region": place_region}})
         G.add_node(PLACES, sym, attrs)
-    for k, ((a, b), w, door) in enumerate(zip(graph.nav.edges.tolist(), graph.nav.weights.tolist(),
-                                              graph.nav.door_edges.tolist())):
+    for k, ((a, b), w, door) in enumerate(
+        zip(graph.nav.edges.tolist(), graph.nav.weights.tolist(), graph.nav.door_edges.tolist())
+    ):
         G.insert_edge(places[a], places[b], _edge(dsg, weight=w, door=bool(door), order=k))
     rooms = {}
     for k, (rid, region) in enumerate(sorted(graph.regions.items())):
         attrs = dsg.RoomNodeAttributes()
         attrs.position = np.array([*region.centroid, 0.0])
         attrs.name = region.room_label or rid
-        attrs.metadata.set({KEY: {"region_id": rid, "room_label": region.room_label,
-                                  "frontiers": [list(f) for f in region.frontiers]}})
+        attrs.metadata.set(
+            {KEY: {"region_id": rid, "room_label": region.room_label, "frontiers": [list(f) for f in region.frontiers]}}
+        )
         rooms[rid] = dsg.NodeSymbol("R", k)
         G.add_node(ROOMS, rooms[rid], attrs)
         for i in region.nav_nodes:
@@ -91,8 +93,11 @@ def to_spark_dsg(graph: SceneGraph) -> Any:
             near = nodes[int(np.argmin(np.linalg.norm(graph.nav.node_xy[nodes] - obj.position[:2], axis=1)))]
             G.insert_edge(places[near], symbols[obj.id])
     for k, rel in enumerate(graph.relations):
-        G.insert_edge(symbols[rel.subject], symbols[rel.object],
-                      _edge(dsg, relation=[rel.subject, rel.predicate, rel.object], order=k))
+        G.insert_edge(
+            symbols[rel.subject],
+            symbols[rel.object],
+            _edge(dsg, relation=[rel.subject, rel.predicate, rel.object], order=k),
+        )
     G.metadata.add({KEY: {"step": graph.step, "robot": graph.robot.model_dump()}})
     return G
 
@@ -112,9 +117,19 @@ def _object_attrs(dsg: Any, obj: ObjectNode, label: int) -> Any:
     attrs.bounding_box = dsg.BoundingBox((hi - lo).astype(np.float32), ((lo + hi) / 2).astype(np.float32))
     attrs.semantic_label = label
     attrs.name = obj.label
-    attrs.metadata.set({KEY: {"id": obj.id, "category": obj.category, "instance_id": obj.instance_id,
-                              "label": obj.label, "open": obj.open, "held": obj.held,
-                              "bbox": [list(obj.bbox.min), list(obj.bbox.max)]}})
+    attrs.metadata.set(
+        {
+            KEY: {
+                "id": obj.id,
+                "category": obj.category,
+                "instance_id": obj.instance_id,
+                "label": obj.label,
+                "open": obj.open,
+                "held": obj.held,
+                "bbox": [list(obj.bbox.min), list(obj.bbox.max)],
+            }
+        }
+    )
     return attrs
 
 
@@ -187,10 +202,12 @@ def from_spark_dsg(G: Any, label_map: Mapping[int, str] | None = None) -> SceneG
     regions = _with_frontiers(regions, frontiers, xy, node_region)
     robot = _robot(G, xy, node_region)
     return SceneGraph(
-        step=int((G.metadata.get().get(KEY) or {}).get("step", 0)), robot=robot, regions=regions, objects=objects,
+        step=int((G.metadata.get().get(KEY) or {}).get("step", 0)),
+        robot=robot,
+        regions=regions,
+        objects=objects,
         relations=relations,
-        nav=NavGraphData(node_xy=xy, edges=pairs, weights=weights,
-                         door_edges=doors, node_region=node_region),
+        nav=NavGraphData(node_xy=xy, edges=pairs, weights=weights, door_edges=doors, node_region=node_region),
     )
 
 
@@ -198,8 +215,9 @@ def _parent_in(node: Any, layer_nodes: Mapping[int, Any]) -> Any:
     return next((layer_nodes[p] for p in node.parents() if p in layer_nodes), None) if node.has_parent() else None
 
 
-def _regions(G: Any, real: list[Any], xy: np.ndarray, edges: np.ndarray,
-             lengths: np.ndarray) -> tuple[list[str | None], dict[str, RegionNode]]:
+def _regions(
+    G: Any, real: list[Any], xy: np.ndarray, edges: np.ndarray, lengths: np.ndarray
+) -> tuple[list[str | None], dict[str, RegionNode]]:
     """Region id per place and the regions: rooms, then one per component of room-less places."""
     rooms = {n.id.value: n for n in G.get_layer(ROOMS).nodes} if G.has_layer(ROOMS) else {}
     names, room_labels, frontiers = {}, {}, {}
@@ -234,13 +252,24 @@ def _regions(G: Any, real: list[Any], xy: np.ndarray, edges: np.ndarray,
     for rid in sorted(members):
         mine = members[rid]
         centroid = xy[mine].mean(0) if mine else np.asarray(room_of[rid].attributes.position[:2])
-        regions[rid] = RegionNode(id=rid, room_label=room_labels.get(rid), centroid=tuple(map(float, centroid)),
-                                  nav_nodes=mine, frontiers=frontiers.get(rid, []))
+        regions[rid] = RegionNode(
+            id=rid,
+            room_label=room_labels.get(rid),
+            centroid=tuple(map(float, centroid)),
+            nav_nodes=mine,
+            frontiers=frontiers.get(rid, []),
+        )
     return node_region, regions
 
 
-def _objects(G: Any, label_map: Mapping[int, str] | None, real: list[Any], index: dict[int, int], xy: np.ndarray,
-             node_region: list[str | None]) -> dict[str, ObjectNode]:
+def _objects(
+    G: Any,
+    label_map: Mapping[int, str] | None,
+    real: list[Any],
+    index: dict[int, int],
+    xy: np.ndarray,
+    node_region: list[str | None],
+) -> dict[str, ObjectNode]:
     nodes = [n for n in G.get_layer(OBJECTS).nodes] if G.has_layer(OBJECTS) else []
     space = {**_labelspace(G, OBJECTS, "OBJECTS"), **(label_map or {})}
     rooms = {n.id.value: n for n in G.get_layer(ROOMS).nodes} if G.has_layer(ROOMS) else {}
@@ -250,8 +279,10 @@ def _objects(G: Any, label_map: Mapping[int, str] | None, real: list[Any], index
         a, meta = n.attributes, _meta(n.attributes)
         category = meta.get("category") or space.get(int(a.semantic_label))
         if category is None:
-            raise SparkDsgError(f"object node {n.id} has semantic label {a.semantic_label}, which neither the graph's "
-                                "OBJECTS label space nor the label map names; pass --label-map FILE (JSON {label: name})")
+            raise SparkDsgError(
+                f"object node {n.id} has semantic label {a.semantic_label}, which neither the graph's "
+                "OBJECTS label space nor the label map names; pass --label-map FILE (JSON {label: name})"
+            )
         k = per_category.get(category, 0)
         per_category[category] = k + 1
         label = meta.get("label") or f"{category} {letters(k)}"
@@ -265,16 +296,30 @@ def _objects(G: Any, label_map: Mapping[int, str] | None, real: list[Any], index
         if region is None and not held:
             continue  # no place to hang it on: a graph without places
         out[meta.get("id") or label] = ObjectNode(
-            id=meta.get("id") or label, category=category, instance_id=int(meta.get("instance_id", n.id.category_id)),
-            label=label, region_id=region, position=tuple(map(float, a.position)), bbox=Box3D(min=lo, max=hi),
-            open=meta.get("open"), held=held)
+            id=meta.get("id") or label,
+            category=category,
+            instance_id=int(meta.get("instance_id", n.id.category_id)),
+            label=label,
+            region_id=region,
+            position=tuple(map(float, a.position)),
+            bbox=Box3D(min=lo, max=hi),
+            open=meta.get("open"),
+            held=held,
+        )
     return out
 
 
-def _object_region(node: Any, attrs: Any, rooms: Mapping[int, Any], real: list[Any], index: dict[int, int],
-                   xy: np.ndarray, node_region: list[str | None]) -> str | None:
+def _object_region(
+    node: Any,
+    attrs: Any,
+    rooms: Mapping[int, Any],
+    real: list[Any],
+    index: dict[int, int],
+    xy: np.ndarray,
+    node_region: list[str | None],
+) -> str | None:
     """Its parent place's region, else its parent room's, else the nearest place's."""
-    for p in (node.parents() if node.has_parent() else []):
+    for p in node.parents() if node.has_parent() else []:
         if p in index:
             return node_region[index[p]]
         if p in rooms:
@@ -299,13 +344,16 @@ def _relations(G: Any, objects: dict[str, ObjectNode]) -> list[Relation]:
     for placed in by_region.values():  # per region: the pairs test is quadratic, and relations stay within rooms
         lo = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
         hi = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
-        relations += [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
-                      for a, p, b in spatial_relations(lo, hi, tol_m=RELATION_TOL_M, inside_fraction=INSIDE_FRACTION)]
+        relations += [
+            Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
+            for a, p, b in spatial_relations(lo, hi, tol_m=RELATION_TOL_M, inside_fraction=INSIDE_FRACTION)
+        ]
     return relations
 
 
-def _with_frontiers(regions: dict[str, RegionNode], frontiers: list[Any], xy: np.ndarray,
-                    node_region: list[str | None]) -> dict[str, RegionNode]:
+def _with_frontiers(
+    regions: dict[str, RegionNode], frontiers: list[Any], xy: np.ndarray, node_region: list[str | None]
+) -> dict[str, RegionNode]:
     """Regions with our frontiers (from metadata) or Hydra's frontier places, at the nearest place's region."""
     extra: dict[str, list[tuple[float, float]]] = {}
     for f in frontiers:
@@ -321,8 +369,6 @@ def _robot(G: Any, xy: np.ndarray, node_region: list[str | None]) -> RobotNode:
     if meta:
         return RobotNode.model_validate(meta)
     agents = [n for n in G.nodes if isinstance(n.attributes, _dsg().AgentNodeAttributes)]
-    position = (agents[-1].attributes.position[:2] if agents else xy[0] if len(xy) else (0.0, 0.0))
+    position = agents[-1].attributes.position[:2] if agents else xy[0] if len(xy) else (0.0, 0.0)
     region = node_region[int(np.argmin(np.linalg.norm(xy - np.asarray(position), axis=1)))] if len(xy) else None
     return RobotNode(position=(float(position[0]), float(position[1])), region_id=region)
-
-

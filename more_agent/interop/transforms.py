@@ -46,8 +46,16 @@ class TransformBuffer:
         self.max_gap_s = max_gap_s
         self._edges: dict[str, _Edge] = {}
 
-    def add(self, parent: str, child: str, stamp_s: float, translation: ArrayLike, quaternion_xyzw: ArrayLike,
-            *, static: bool = False) -> None:
+    def add(
+        self,
+        parent: str,
+        child: str,
+        stamp_s: float,
+        translation: ArrayLike,
+        quaternion_xyzw: ArrayLike,
+        *,
+        static: bool = False,
+    ) -> None:
         """One sample of the pose of ``child`` in ``parent`` (a frame has one parent, as in tf2)."""
         edge = self._edges.setdefault(child, _Edge(parent=parent, static=static))
         if edge.parent != parent:
@@ -70,8 +78,10 @@ class TransformBuffer:
             edge = self._edges.get(frame)
             if edge is None:
                 chain = " -> ".join([*seen, frame])
-                raise BagError(f"no transform from {source!r} to {target!r} at t={stamp_s:.3f} s (chain {chain} ends "
-                               f"at {frame!r}); check --world-frame / --camera-frame or the /tf topics")
+                raise BagError(
+                    f"no transform from {source!r} to {target!r} at t={stamp_s:.3f} s (chain {chain} ends "
+                    f"at {frame!r}); check --world-frame / --camera-frame or the /tf topics"
+                )
             T = self._at(edge, frame, stamp_s) @ T
             seen.append(frame)
             frame = edge.parent
@@ -80,14 +90,18 @@ class TransformBuffer:
     def _at(self, edge: _Edge, child: str, t: float) -> np.ndarray:
         if edge.static or len(edge.stamps) == 1:
             if not edge.static and abs(t - edge.stamps[0]) > self.max_gap_s:
-                raise BagError(f"transform {edge.parent} -> {child}: no sample within {self.max_gap_s} s of t={t:.3f} s")
+                raise BagError(
+                    f"transform {edge.parent} -> {child}: no sample within {self.max_gap_s} s of t={t:.3f} s"
+                )
             return pose_matrix(edge.translations[0], edge.quaternions[0])
         i = bisect.bisect(edge.stamps, t)
         if i == 0 or i == len(edge.stamps):
             end = 0 if i == 0 else -1
             if abs(t - edge.stamps[end]) > self.max_gap_s:
-                raise BagError(f"transform {edge.parent} -> {child}: t={t:.3f} s is outside its samples "
-                               f"[{edge.stamps[0]:.3f}, {edge.stamps[-1]:.3f}] s")
+                raise BagError(
+                    f"transform {edge.parent} -> {child}: t={t:.3f} s is outside its samples "
+                    f"[{edge.stamps[0]:.3f}, {edge.stamps[-1]:.3f}] s"
+                )
             return pose_matrix(edge.translations[end], edge.quaternions[end])
         t0, t1 = edge.stamps[i - 1], edge.stamps[i]
         w = 0.0 if t1 == t0 else (t - t0) / (t1 - t0)

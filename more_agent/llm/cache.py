@@ -38,6 +38,7 @@ def check_cache_path(path: Path, *, write: bool = True) -> None:
     if not os.access(target, (os.W_OK if write else os.R_OK)):
         raise CacheUnusable(f"LLM cache {path} is not {'writable' if write else 'readable'}; {hint}")
 
+
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS responses (
     key TEXT PRIMARY KEY,
@@ -87,7 +88,9 @@ class ResponseCache:
     def _error(self, doing: str, e: Exception) -> CacheLocked | CacheUnusable:
         """The typed error of a failed sqlite operation: locked or busy is transient, the rest is not."""
         if isinstance(e, sqlite3.OperationalError) and ("locked" in str(e) or "busy" in str(e)):
-            return CacheLocked(f"LLM cache {self.path} stayed locked by another process for {self._busy_timeout_s:g} s: {e}")
+            return CacheLocked(
+                f"LLM cache {self.path} stayed locked by another process for {self._busy_timeout_s:g} s: {e}"
+            )
         return CacheUnusable(f"cannot {doing} LLM cache {self.path}: {e}")
 
     def _open(self) -> sqlite3.Connection:
@@ -104,9 +107,11 @@ class ResponseCache:
     def get(self, key: str) -> CachedAnswer | None:
         """The stored answer for ``key``, or None."""
         try:
-            row = self._connection().execute(
-                "SELECT text, model, prompt_tokens, completion_tokens FROM responses WHERE key = ?", (key,)
-            ).fetchone()
+            row = (
+                self._connection()
+                .execute("SELECT text, model, prompt_tokens, completion_tokens FROM responses WHERE key = ?", (key,))
+                .fetchone()
+            )
         except sqlite3.Error as e:
             raise self._error("read", e) from None
         return CachedAnswer(*row) if row else None

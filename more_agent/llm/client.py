@@ -171,7 +171,11 @@ class ChatClient:
             if self.cache is not None and self.cache_mode in (CacheMode.ON, CacheMode.REFRESH):
                 self.cache.put(key, request=key_fields, purpose=purpose, answer=answer)
         completion = self._completion(
-            answer, request, cached=hit is not None, attempts=attempts, purpose=purpose,
+            answer,
+            request,
+            cached=hit is not None,
+            attempts=attempts,
+            purpose=purpose,
             latency_s=time.perf_counter() - start,
         )
         completion = dataclasses.replace(completion, **dataclasses.asdict(image_stats(request.messages)))
@@ -180,12 +184,19 @@ class ChatClient:
             raise OversizeAnswer(completion=completion)
         log.debug(
             "llm %s model=%s tokens=%d+%d cost=%.5f cached=%s latency=%.2fs attempts=%d",
-            purpose or "call", completion.model, completion.usage.prompt_tokens, completion.usage.completion_tokens,
-            completion.cost_usd, completion.cached, completion.latency_s, completion.attempts,
+            purpose or "call",
+            completion.model,
+            completion.usage.prompt_tokens,
+            completion.usage.completion_tokens,
+            completion.cost_usd,
+            completion.cached,
+            completion.latency_s,
+            completion.attempts,
         )
         if request.schema is not None and completion.parsed is None:
             raise Unparseable(
-                f"no JSON object in the answer to {purpose or 'a request'}: {answer.text[:200]!r}", completion=completion
+                f"no JSON object in the answer to {purpose or 'a request'}: {answer.text[:200]!r}",
+                completion=completion,
             )
         return completion
 

@@ -86,19 +86,27 @@ class LLMConfig(BaseModel):
     max_tokens: int = Field(default=C.DEFAULT_MAX_TOKENS, gt=0, description="Upper bound on tokens of one answer.")
     seed: int | None = Field(default=None, description="Sampling seed sent to servers that honour it.")
     timeout_s: float = Field(
-        default=C.DEFAULT_TIMEOUT_S, gt=0, le=MAX_TIMEOUT_S,
+        default=C.DEFAULT_TIMEOUT_S,
+        gt=0,
+        le=MAX_TIMEOUT_S,
         description="Wall-clock seconds one HTTP request may take in all: connect, headers and body.",
     )
     max_retries: int = Field(default=C.DEFAULT_MAX_RETRIES, ge=0, description="Retries on timeouts, 429, 5xx, drops.")
-    backoff_initial_s: float = Field(default=C.INITIAL_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="First sleep between retries.")
-    backoff_max_s: float = Field(default=C.MAX_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="Longest sleep between retries.")
+    backoff_initial_s: float = Field(
+        default=C.INITIAL_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="First sleep between retries."
+    )
+    backoff_max_s: float = Field(
+        default=C.MAX_BACKOFF_S, ge=0, le=MAX_TIMEOUT_S, description="Longest sleep between retries."
+    )
     structured_output: StructuredOutput = Field(
         default=StructuredOutput.AUTO, description="Send JSON schemas as response_format: auto, always or never."
     )
     cache_mode: CacheMode = Field(default=CacheMode.ON, description="Response cache use: on, refresh, off, replay.")
     cache_path: Path = Field(default=C.DEFAULT_CACHE_PATH, description="sqlite file of the response cache.")
     cache_busy_timeout_s: float = Field(
-        default=C.CACHE_BUSY_TIMEOUT_S, ge=0, le=MAX_TIMEOUT_S,
+        default=C.CACHE_BUSY_TIMEOUT_S,
+        ge=0,
+        le=MAX_TIMEOUT_S,
         description="How long to wait for another process's lock on the cache before the call fails (transient).",
     )
     prices: dict[str, ModelPrice] = Field(
@@ -107,7 +115,8 @@ class LLMConfig(BaseModel):
     llamacpp_n_ctx: int = Field(default=8192, gt=0, description="Context length for in-process GGUF models.")
     llamacpp_n_gpu_layers: int = Field(default=0, description="Layers offloaded to the GPU by llama.cpp (-1 = all).")
     llamacpp_n_threads: int | None = Field(
-        default=None, gt=0,
+        default=None,
+        gt=0,
         description="CPU threads of in-process GGUF models, prompts and generation; None = llama.cpp's choice.",
     )
 

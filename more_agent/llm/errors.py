@@ -110,7 +110,9 @@ class OversizeAnswer(Unparseable):
     """The answer is longer than ``MAX_ANSWER_CHARS``: invalid, whatever it holds (recorded truncated)."""
 
     def __init__(self, *, completion: Completion) -> None:
-        self.reason = f"the answer is over the limit of {MAX_ANSWER_CHARS} characters; answer with one short JSON object"
+        self.reason = (
+            f"the answer is over the limit of {MAX_ANSWER_CHARS} characters; answer with one short JSON object"
+        )
         super().__init__(self.reason, completion=completion)
 
 

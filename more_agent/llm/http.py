@@ -75,12 +75,19 @@ def _deadline_backend() -> Any:
     inner = httpcore2.SyncBackend()
 
     class DeadlineBackend(httpcore2.NetworkBackend):
-        def connect_tcp(self, host: str, port: int, timeout: float | None = None, local_address: str | None = None,
-                        socket_options: Iterable[Any] | None = None) -> Any:
+        def connect_tcp(
+            self,
+            host: str,
+            port: int,
+            timeout: float | None = None,
+            local_address: str | None = None,
+            socket_options: Iterable[Any] | None = None,
+        ) -> Any:
             return _deadline_stream(inner.connect_tcp(host, port, _left(timeout), local_address, socket_options))
 
-        def connect_unix_socket(self, path: str, timeout: float | None = None,
-                                socket_options: Iterable[Any] | None = None) -> Any:
+        def connect_unix_socket(
+            self, path: str, timeout: float | None = None, socket_options: Iterable[Any] | None = None
+        ) -> Any:
             return _deadline_stream(inner.connect_unix_socket(path, _left(timeout), socket_options))
 
         def sleep(self, seconds: float) -> None:
@@ -105,9 +112,12 @@ def bounded_client(timeout_s: float, *, max_body_bytes: int = MAX_BODY_BYTES) ->
                 response.close()
                 _deadline.at = None
                 raise BodyTooLarge(int(length), max_body_bytes)
-            return httpx2.Response(response.status_code, headers=response.headers,
-                                   stream=_CappedStream(response.stream, max_body_bytes),
-                                   extensions=response.extensions)
+            return httpx2.Response(
+                response.status_code,
+                headers=response.headers,
+                stream=_CappedStream(response.stream, max_body_bytes),
+                extensions=response.extensions,
+            )
 
     transport = BoundedTransport()
     # httpx builds its connection pool without a choice of network backend; the deadline lives there.

@@ -113,8 +113,12 @@ class LlamaCppBackend:
     def from_config(cls, model_path: Path, config: LLMConfig, *, require_model: bool = True) -> LlamaCppBackend:
         """A backend for the file, sized by the config."""
         return cls(
-            model_path, n_ctx=config.llamacpp_n_ctx, n_gpu_layers=config.llamacpp_n_gpu_layers, seed=config.seed,
-            n_threads=config.llamacpp_n_threads, require_model=require_model,
+            model_path,
+            n_ctx=config.llamacpp_n_ctx,
+            n_gpu_layers=config.llamacpp_n_gpu_layers,
+            seed=config.seed,
+            n_threads=config.llamacpp_n_threads,
+            require_model=require_model,
         )
 
     def llama(self) -> Any:
@@ -133,7 +137,8 @@ class LlamaCppBackend:
             from llama_cpp.llama_chat_format import Jinja2ChatFormatter
 
             self._formatter = Jinja2ChatFormatter(
-                template=llm.metadata[CHAT_TEMPLATE_KEY], eos_token=_token_text(llm, llm.token_eos()),
+                template=llm.metadata[CHAT_TEMPLATE_KEY],
+                eos_token=_token_text(llm, llm.token_eos()),
                 bos_token=_token_text(llm, llm.token_bos()),
             )
         rendered = self._formatter(messages=list(messages))
@@ -149,7 +154,8 @@ class LlamaCppBackend:
             raise ContextLimitExceeded(
                 f"prompt of {n_prompt} tokens plus an answer budget of {request.max_tokens} (max_tokens) exceed the "
                 f"{n_ctx}-token context of {self.model} (llamacpp_n_ctx, at most the model's training context)",
-                prompt_tokens=n_prompt, n_ctx=n_ctx,
+                prompt_tokens=n_prompt,
+                n_ctx=n_ctx,
             )
         extra: dict[str, Any] = {}
         if request.schema is not None:
@@ -157,7 +163,10 @@ class LlamaCppBackend:
         if request.seed is not None:
             extra["seed"] = request.seed
         out = self.llama().create_chat_completion(
-            messages=list(request.messages), temperature=request.temperature, max_tokens=request.max_tokens, **extra,
+            messages=list(request.messages),
+            temperature=request.temperature,
+            max_tokens=request.max_tokens,
+            **extra,
         )
         choice = out["choices"][0]
         if choice.get("finish_reason") == "length":

@@ -151,7 +151,10 @@ class OpenAIBackend:
             from more_agent.llm.http import bounded_client
 
             self._sdk = openai.OpenAI(
-                api_key=self._api_key, base_url=self.base_url, timeout=self.timeout_s, max_retries=0,
+                api_key=self._api_key,
+                base_url=self.base_url,
+                timeout=self.timeout_s,
+                max_retries=0,
                 http_client=bounded_client(self.timeout_s),
             )
         return self._sdk
@@ -223,14 +226,19 @@ class OpenAIBackend:
             except _SchemaRejected as rejected:
                 e = rejected.error
                 if self.structured_output is StructuredOutput.AUTO:
-                    later = SCHEMA_FORMATS[SCHEMA_FORMATS.index(schema_format) + 1:]
+                    later = SCHEMA_FORMATS[SCHEMA_FORMATS.index(schema_format) + 1 :]
                     self.schema_format = later[0] if later else None
-                    log.warning("%s rejected response_format %s (%s); now %s", self.base_url, schema_format,
-                                clip(str(e), MAX_ERROR_CHARS),
-                                f"sending {later[0]}" if later else "parsing JSON from text")
+                    log.warning(
+                        "%s rejected response_format %s (%s); now %s",
+                        self.base_url,
+                        schema_format,
+                        clip(str(e), MAX_ERROR_CHARS),
+                        f"sending {later[0]}" if later else "parsing JSON from text",
+                    )
                     continue
                 raise LLMBadRequest(
-                    f"{self.base_url} rejected response_format {schema_format}: {e}", status_code=e.status_code,
+                    f"{self.base_url} rejected response_format {schema_format}: {e}",
+                    status_code=e.status_code,
                     attempts=attempts,
                 ) from None
             except BodyTooLarge as e:
@@ -249,7 +257,9 @@ class OpenAIBackend:
                 error = LLMServerError(str(e), status_code=e.status_code, attempts=attempts)
             except openai.APIResponseValidationError as e:
                 error = LLMServerError(
-                    f"{self.base_url} sent an invalid chat completion: {e}", status_code=e.status_code, attempts=attempts
+                    f"{self.base_url} sent an invalid chat completion: {e}",
+                    status_code=e.status_code,
+                    attempts=attempts,
                 )
             except ValueError as e:  # the SDK's json.JSONDecodeError: a body that is not JSON at all
                 error = LLMServerError(

@@ -130,9 +130,7 @@ def parse_plan_answer(
         valid = valid_rooms if kind == "room" else valid_objects
         name_ok = resolve_name(arg, valid)
         if name_ok is None:
-            raise InvalidAnswer(
-                f"unknown {kind} {arg!r} in {canonical}({', '.join(args)}){_closest_hint(arg, valid)}"
-            )
+            raise InvalidAnswer(f"unknown {kind} {arg!r} in {canonical}({', '.join(args)}){_closest_hint(arg, valid)}")
         resolved[kind] = name_ok
     return PlannedAction(
         skill=canonical,

@@ -90,8 +90,9 @@ def check_history(mode: str) -> HistoryMode:
     for m in HISTORY_MODES:
         if mode == m:
             return m
-    raise UserError(f"{unknown_name_error('history', mode, HISTORY_MODES)}; use --history with one of: "
-                    f"{', '.join(HISTORY_MODES)}")
+    raise UserError(
+        f"{unknown_name_error('history', mode, HISTORY_MODES)}; use --history with one of: {', '.join(HISTORY_MODES)}"
+    )
 
 
 def history_text(

@@ -37,9 +37,7 @@ def parse_llm_spec(spec: str) -> LLMSpec:
     into records, caches and run.json; keys belong in the environment.
     """
     if has_credentials(spec):
-        raise BadLLMSpec(
-            "the LLM spec must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)"
-        )
+        raise BadLLMSpec("the LLM spec must not contain credentials; set them in the environment (e.g. OPENAI_API_KEY)")
     kind, sep, model = spec.strip().partition(":")
     kind, model = kind.strip().lower(), model.strip()
     if not sep:

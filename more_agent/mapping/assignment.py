@@ -72,8 +72,15 @@ def lines_of_sight(points: np.ndarray, targets: np.ndarray, blocked: np.ndarray,
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
     targets = np.ascontiguousarray(targets, dtype=np.float64).reshape(len(points), -1, 2)
     seen = np.empty(targets.shape[:2], dtype=np.bool_)
-    _sight(points, targets, np.ascontiguousarray(blocked, dtype=np.bool_), float(grid.origin_xy[0]),
-           float(grid.origin_xy[1]), float(grid.resolution_m), seen)
+    _sight(
+        points,
+        targets,
+        np.ascontiguousarray(blocked, dtype=np.bool_),
+        float(grid.origin_xy[0]),
+        float(grid.origin_xy[1]),
+        float(grid.resolution_m),
+        seen,
+    )
     return seen
 
 
@@ -183,14 +190,22 @@ def assign_objects(
     return out
 
 
-def _near_nodes(points: np.ndarray, tree: cKDTree, cand: np.ndarray, kk: int, graph: NavGraph,
-                blocked: np.ndarray | None, grid: Grid | None, radius_m: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def _near_nodes(
+    points: np.ndarray,
+    tree: cKDTree,
+    cand: np.ndarray,
+    kk: int,
+    graph: NavGraph,
+    blocked: np.ndarray | None,
+    grid: Grid | None,
+    radius_m: float,
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """S_p of Eq. 1 for each point: its ``kk`` nearest candidate nodes, those it sees if it sees any,
     within ``radius_m`` (or the closest); as (node indices, distances), nearest first."""
     d, i = tree.query(points, k=kk)
     d, i = d.reshape(len(points), kk), i.reshape(len(points), kk)
     keep = np.ones(d.shape, dtype=bool)
-    if blocked is not None:
+    if blocked is not None and grid is not None:  # both or neither (checked by the caller)
         seen = lines_of_sight(points, graph.xy[cand[i]], blocked, grid)
         keep = seen | ~seen.any(axis=1, keepdims=True)
     first = np.take_along_axis(d, np.argmax(keep, axis=1)[:, None], axis=1)

@@ -18,16 +18,24 @@ class MappingConfig(BaseModel):
     bev_max_height_m: float = Field(
         2.0, description="Voxels centred above this height (door lintels, ceilings) are ignored by the BEV."
     )
-    carve_stride_px: int = Field(2, ge=1, description="Free-space clearing casts one ray per this many pixels in u and v.")
+    carve_stride_px: int = Field(
+        2, ge=1, description="Free-space clearing casts one ray per this many pixels in u and v."
+    )
     initial_extent_m: float = Field(20.0, gt=0, description="Side of the first voxel grid; it grows as needed.")
-    inflation_m: float = Field(0.15, ge=0, description="ESDF inflation: free cells closer than this to a non-free cell are excluded.")
+    inflation_m: float = Field(
+        0.15, ge=0, description="ESDF inflation: free cells closer than this to a non-free cell are excluded."
+    )
     gvd_min_separation_m: float = Field(
         0.3, gt=0, description="Neighbouring cells straddle the GVD when their nearest obstacles are farther apart."
     )
-    sparsify_threshold_m: float = Field(1.0, gt=0, description="Alg. 1 threshold c on the sum of a degree-2 node's two edges.")
+    sparsify_threshold_m: float = Field(
+        1.0, gt=0, description="Alg. 1 threshold c on the sum of a degree-2 node's two edges."
+    )
     door_min_sigma_m: float = Field(0.15, gt=0, description="Lower bound on a door kernel's standard deviations.")
     door_cut_threshold_m: float = Field(
-        0.15, gt=0, description="An edge whose line integral of the door kernels exceeds this is cut (metres x unit peak)."
+        0.15,
+        gt=0,
+        description="An edge whose line integral of the door kernels exceeds this is cut (metres x unit peak).",
     )
     door_mask_value: float = Field(
         0.05, gt=0, lt=1, description="Cells where a door kernel exceeds this count as doorway (not merged across)."
@@ -36,9 +44,19 @@ class MappingConfig(BaseModel):
         True, description="Merge graph components that share one door-free connected patch of free space (paper S.5)."
     )
     assignment_lambda: float = Field(1.3, gt=0, description="Exponent lambda on the object-node distance in Eq. 1.")
-    assignment_radius_m: float = Field(2.5, gt=0, description="Nodes within this radius of an object / viewpoint form S_O / S_vp.")
+    assignment_radius_m: float = Field(
+        2.5, gt=0, description="Nodes within this radius of an object / viewpoint form S_O / S_vp."
+    )
     assignment_k: int = Field(8, ge=1, description="At most this many nearest nodes per set in Eq. 1.")
-    relation_tol_m: float = Field(0.08, ge=0, description="Vertical gap tolerated between a supported object and its support.")
-    inside_fraction: float = Field(0.7, gt=0, le=1, description="Share of an object's box inside another's box for 'inside'.")
-    min_frontier_m: float = Field(0.3, ge=0, description="Frontier clusters shorter than this (cells x resolution) are dropped.")
-    viewpoint_spacing_m: float = Field(0.25, gt=0, description="Viewpoints closer than this are stored once per object.")
+    relation_tol_m: float = Field(
+        0.08, ge=0, description="Vertical gap tolerated between a supported object and its support."
+    )
+    inside_fraction: float = Field(
+        0.7, gt=0, le=1, description="Share of an object's box inside another's box for 'inside'."
+    )
+    min_frontier_m: float = Field(
+        0.3, ge=0, description="Frontier clusters shorter than this (cells x resolution) are dropped."
+    )
+    viewpoint_spacing_m: float = Field(
+        0.25, gt=0, description="Viewpoints closer than this are stored once per object."
+    )

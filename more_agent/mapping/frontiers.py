@@ -65,7 +65,12 @@ def frontier_points(
 
 
 def visible_unknown_area(
-    occupancy: np.ndarray, grid: Grid, points: np.ndarray, *, range_m: float, rays: int = 48,
+    occupancy: np.ndarray,
+    grid: Grid,
+    points: np.ndarray,
+    *,
+    range_m: float,
+    rays: int = 48,
 ) -> np.ndarray:
     """Unknown floor area (m^2) in sensor range of each point that no known obstacle hides.
 

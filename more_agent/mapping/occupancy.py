@@ -217,8 +217,20 @@ class VoxelMap:
         use = ~np.isin(instance, ignore) if ignore.size else np.ones(depth.shape, dtype=np.bool_)
         res = self.grid.resolution_m
         _carve(depth, intr, rot, trans, self.cls, origin, res, r, self.carve_stride_px, self._free_lut)
-        _insert(depth, semantic.astype(np.int32, copy=False), instance.astype(np.int32, copy=False), use,
-                intr, rot, trans, self.cls, self.inst, origin, res, r)
+        _insert(
+            depth,
+            semantic.astype(np.int32, copy=False),
+            instance.astype(np.int32, copy=False),
+            use,
+            intr,
+            rot,
+            trans,
+            self.cls,
+            self.inst,
+            origin,
+            res,
+            r,
+        )
         lo, hi = self.grid.cell_range(trans[:2] - r, trans[:2] + r)
         lo, hi = np.maximum(lo, 0), np.minimum(hi + 1, self.shape)  # one cell of margin
         _update_top(self.cls, self.top_class, lo[0], hi[0], lo[1], hi[1], self._top_level)

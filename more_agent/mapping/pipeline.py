@@ -97,8 +97,7 @@ def region_graph(
     """
     cfg = config or MappingConfig()
     marks = [time.perf_counter()]
-    dense = voronoi_graph(occupancy, grid, inflation_m=cfg.inflation_m,
-                          min_separation_m=cfg.gvd_min_separation_m)
+    dense = voronoi_graph(occupancy, grid, inflation_m=cfg.inflation_m, min_separation_m=cfg.gvd_min_separation_m)
     marks.append(time.perf_counter())
     graph, _ = sparsify(dense, threshold_m=cfg.sparsify_threshold_m)
     marks.append(time.perf_counter())
@@ -110,11 +109,26 @@ def region_graph(
         labels = merge_subregions(labels, grid.cell_of(graph.xy), occupancy, doorway)
     marks.append(time.perf_counter())
     assigned = assign_objects(
-        graph, labels, objects_xy, viewpoints_xy, cut=cut, blocked=blocked, grid=grid,
-        lam=cfg.assignment_lambda, radius_m=cfg.assignment_radius_m, k=cfg.assignment_k,
+        graph,
+        labels,
+        objects_xy,
+        viewpoints_xy,
+        cut=cut,
+        blocked=blocked,
+        grid=grid,
+        lam=cfg.assignment_lambda,
+        radius_m=cfg.assignment_radius_m,
+        k=cfg.assignment_k,
     )
     marks.append(time.perf_counter())
     frontier_xy, _ = frontier_points(occupancy, grid, min_length_m=cfg.min_frontier_m)
     marks.append(time.perf_counter())
-    return RegionGraph(dense=dense, graph=graph, cut=cut, labels=labels, assigned=assigned, frontier_xy=frontier_xy,
-                       timings_s=dict(zip(STAGES, np.diff(marks).tolist())))
+    return RegionGraph(
+        dense=dense,
+        graph=graph,
+        cut=cut,
+        labels=labels,
+        assigned=assigned,
+        frontier_xy=frontier_xy,
+        timings_s=dict(zip(STAGES, np.diff(marks).tolist())),
+    )

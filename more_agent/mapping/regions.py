@@ -286,8 +286,8 @@ def doorway_mask(
         lo, hi = np.maximum(lo, 0), np.minimum(hi + 1, shape)  # one cell of margin
         if (hi <= lo).any():
             continue
-        centres = grid.xy_of(np.stack(list(np.mgrid[lo[0]:hi[0], lo[1]:hi[1]]), axis=-1))
-        mask[lo[0]:hi[0], lo[1]:hi[1]] |= door_field(centres, [door]) > value
+        centres = grid.xy_of(np.stack(list(np.mgrid[lo[0] : hi[0], lo[1] : hi[1]]), axis=-1))
+        mask[lo[0] : hi[0], lo[1] : hi[1]] |= door_field(centres, [door]) > value
     return mask
 
 

@@ -90,7 +90,7 @@ def sparsify(graph: NavGraph, *, threshold_m: float) -> tuple[NavGraph, np.ndarr
     rows = np.repeat(kept, width)
     cols = nbr[kept].ravel()
     ws = wt[kept].ravel()
-    ok = (cols > rows)  # each edge once; -1 slots fail this test
+    ok = cols > rows  # each edge once; -1 slots fail this test
     new_index = np.cumsum(keep) - 1
     edges = np.stack([new_index[rows[ok]], new_index[cols[ok]]], axis=1)
     return NavGraph(graph.xy[keep], edges, ws[ok]), kept

@@ -164,7 +164,7 @@ def voronoi_graph(
     rows, cols = np.nonzero(free.any(axis=1))[0], np.nonzero(free.any(axis=0))[0]
     r0, c0 = rows[0] - 1, cols[0] - 1  # one non-free ring around the crop
     crop = np.zeros((rows[-1] - rows[0] + 3, cols[-1] - cols[0] + 3), dtype=bool)
-    crop[1:-1, 1:-1] = free[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+    crop[1:-1, 1:-1] = free[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
     # feature indices only (int32): the distances follow from them without scipy's float temporaries
     feat_r, feat_c = ndimage.distance_transform_edt(crop, return_distances=False, return_indices=True)
     res = grid.resolution_m

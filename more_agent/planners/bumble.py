@@ -97,7 +97,9 @@ class BumbleConfig(BaseModel):
 
     name: str = Field(description="Planner name as registered.")
     filtering: bool = Field(description="Mark and list only the objects MORE's filter keeps.")
-    max_reasks: int = Field(default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action.")
+    max_reasks: int = Field(
+        default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action."
+    )
     memory: MemoryConfig = Field(default_factory=MemoryConfig, description="Frame buffer and images per request.")
     policy: PolicyConfig = Field(default_factory=PolicyConfig, description="Subpolicy knobs.")
     mapping: MappingConfig = Field(default_factory=MappingConfig, description="Mapping and scene-graph knobs.")
@@ -203,7 +205,9 @@ class BumblePlanner:
         self.memory.step = len(self.history)
         self.step_log = StepLog()
         self.calls.new_step()
-        self.graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
+        self.graph = without_visited_frontiers(
+            body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m
+        )
         view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
         self.relevant = self._filter(view) if self.config.filtering else None
@@ -234,8 +238,12 @@ class BumblePlanner:
         """The step's action, subtask, the frames offered and picked (its ``steps.jsonl`` line) and the VLM's images."""
         step = self.step_log
         log_line = {
-            "action": self.history[-1].model_dump(), "subtask": step.subtask, "offered_frames": step.offered_frames,
-            "frame": step.frame, "marks": step.marks, "buffer_frames": len(self.memory.frames),
+            "action": self.history[-1].model_dump(),
+            "subtask": step.subtask,
+            "offered_frames": step.offered_frames,
+            "frame": step.frame,
+            "marks": step.marks,
+            "buffer_frames": len(self.memory.frames),
         }
         return StepTrace(log=log_line, pictures=step.pictures)
 
@@ -289,29 +297,47 @@ class BumblePlanner:
         ]
         held = graph.held_object
         return step_messages(
-            task=self.task, view=view, objects=objects, held=held.label if held is not None else None, history=past,
-            feedback=self.feedback, history_mode=self.history_mode,
+            task=self.task,
+            view=view,
+            objects=objects,
+            held=held.label if held is not None else None,
+            history=past,
+            feedback=self.feedback,
+            history_mode=self.history_mode,
         )
 
     def _object_target(self, subtask: str) -> Decision:
         """Landmark step (which frame), then object step (which mark in it)."""
         frames = self.memory.frames
-        wanted = {self._graph().objects[o].instance_id for o in self.markable({i for f in frames for i in f.instance_ids})}
+        wanted = {
+            self._graph().objects[o].instance_id for o in self.markable({i for f in frames for i in f.instance_ids})
+        }
         offered = covering_frames(frames, wanted, self.config.memory.max_images)
         if not offered:
             return Decision(subtask=subtask, failure="no object to go to has been seen yet")
         self.step_log.offered_frames = [f.index for f in offered]
         pictures = self._pictures(offered)
-        k = self._ask(frames_messages("bumble_landmark", task=self.task, subtask=subtask, pictures=pictures),
-                      FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "landmark")
+        k = self._ask(
+            frames_messages("bumble_landmark", task=self.task, subtask=subtask, pictures=pictures),
+            FrameAnswer,
+            lambda a: parse_choice(a, "frame", len(offered)),
+            "landmark",
+        )
         frame = offered[k - 1]
         self.step_log.frame = frame.index
-        picture, marked = self.marked_picture(frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:")
+        picture, marked = self.marked_picture(
+            frame.rgb(), frame.instance(), self.markable(frame.instance_ids), "Frame:"
+        )
         self.step_log.marks = dict(enumerate(marked, start=1))
         self.step_log.pictures["object"] = picture.png
-        m = self._ask(object_messages(task=self.task, subtask=subtask, view=picture,
-                                      objects=[self.descriptions[o] for o in marked]),
-                      MarkAnswer, lambda a: parse_choice(a, "mark", len(marked)), "object")
+        m = self._ask(
+            object_messages(
+                task=self.task, subtask=subtask, view=picture, objects=[self.descriptions[o] for o in marked]
+            ),
+            MarkAnswer,
+            lambda a: parse_choice(a, "mark", len(marked)),
+            "object",
+        )
         return Decision(subtask=subtask, target=marked[m - 1])
 
     def _explore_target(self, subtask: str) -> Decision:
@@ -319,15 +345,22 @@ class BumblePlanner:
         graph = self._graph()
         points = np.array([f for r in graph.regions.values() for f in r.frontiers], dtype=float).reshape(-1, 2)
         margin = self.config.memory.occlusion_margin_m
-        seen = {f.index: set(np.flatnonzero(shows_points(f, points, margin_m=margin)).tolist()) for f in self.memory.frames}
+        seen = {
+            f.index: set(np.flatnonzero(shows_points(f, points, margin_m=margin)).tolist()) for f in self.memory.frames
+        }
         showing = [f for f in self.memory.frames if seen[f.index]]
-        offered = covering_frames(showing, set(range(len(points))), self.config.memory.max_images,
-                                  shown=lambda f: seen[f.index])
+        offered = covering_frames(
+            showing, set(range(len(points))), self.config.memory.max_images, shown=lambda f: seen[f.index]
+        )
         if not offered:
             return Decision(subtask=subtask, failure="no unexplored area in view of the robot's memory")
         self.step_log.offered_frames = [f.index for f in offered]
-        k = self._ask(frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
-                      FrameAnswer, lambda a: parse_choice(a, "frame", len(offered)), "explore")
+        k = self._ask(
+            frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
+            FrameAnswer,
+            lambda a: parse_choice(a, "frame", len(offered)),
+            "explore",
+        )
         chosen = offered[k - 1]
         self.step_log.frame = chosen.index
         frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
@@ -342,7 +375,9 @@ class BumblePlanner:
         try:
             achieved, why = self._ask(
                 frames_messages("bumble_verify", task=self.task, subtask=subtask, pictures=self._pictures(shown)),
-                VerifyAnswer, parse_verdict, "verify",
+                VerifyAnswer,
+                parse_verdict,
+                "verify",
             )
         except InvalidAnswer as e:
             return True, f"explored; no verdict on the subtask ({e.reason})"
@@ -352,8 +387,12 @@ class BumblePlanner:
     def _filter(self, view: SceneView) -> set[str]:
         """MORE's filter on every object the VLM could be shown, as one room; all kept when the answer is unusable."""
         objects = tuple(o for r in view.rooms for o in r.objects)
-        flat = SceneView(rooms=(RoomText(OBSERVED_ROOM, "", objects, False),), robot_room=OBSERVED_ROOM,
-                         held=view.held, held_id=view.held_id)
+        flat = SceneView(
+            rooms=(RoomText(OBSERVED_ROOM, "", objects, False),),
+            robot_room=OBSERVED_ROOM,
+            held=view.held,
+            held_id=view.held_id,
+        )
         kept = filter_view(self.client, self.task, flat, max_reasks=self.config.max_reasks)
         return {i for r in kept.rooms for o in r.objects for i in o.ids}
 
@@ -373,7 +412,9 @@ class BumblePlanner:
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}")
+            return ActionResult(
+                ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}"
+            )
         decision, body, graph = self.decision, self._body(), self._graph()
         if action.name == DONE:
             return run_skill(body, graph, DONE, None)

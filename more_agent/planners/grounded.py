@@ -276,8 +276,13 @@ class GroundedPlanner:
         pending = [(lit, h) for lit, h in status if h is not True]
         if not pending:
             why = "; ".join(lit.text for lit in self.skipped)
-            return _Step(HighLevelAction(DONE, note="every goal literal holds in the scene graph",
-                                         gave_up=f"goal literals no subpolicy achieves: {why}" if why else ""))
+            return _Step(
+                HighLevelAction(
+                    DONE,
+                    note="every goal literal holds in the scene graph",
+                    gave_up=f"goal literals no subpolicy achieves: {why}" if why else "",
+                )
+            )
         held = self._graph().held_object
         if held is not None:
             step = self._place_held(held.label, [lit for lit, h in pending if h is False])
@@ -332,7 +337,11 @@ class GroundedPlanner:
             return None
         if not lit.negated and self.goal.is_floor(target) and self._floor_region(target) is None:
             return None  # no room of the floor's type found yet: search for it first
-        if lit.negated and self.goal.is_floor(target) and (self._placed_elsewhere(subject) or self._support_for(a) is None):
+        if (
+            lit.negated
+            and self.goal.is_floor(target)
+            and (self._placed_elsewhere(subject) or self._support_for(a) is None)
+        ):
             return None  # the placement the goal asks for meets it; putting it down again cannot
         if not lit.negated and not self.goal.is_floor(target):
             b = self.bound[target]
@@ -373,11 +382,21 @@ class GroundedPlanner:
         note = f"looking for {', '.join(self.goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
         here = graph.robot.region_id
         items = not missing or any(not self._is_furniture_scope(s) for s in missing)
-        closed = sorted(
-            (o for o in graph.objects.values() if o.open is False and can_hold_things(o.category)
-             and o.label not in self.looked_into and o.label not in self.dropped),
-            key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
-        ) if items else []
+        closed = (
+            sorted(
+                (
+                    o
+                    for o in graph.objects.values()
+                    if o.open is False
+                    and can_hold_things(o.category)
+                    and o.label not in self.looked_into
+                    and o.label not in self.dropped
+                ),
+                key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label),
+            )
+            if items
+            else []
+        )
         task_rooms = self._task_rooms()
         region = self._room_to_explore(missing, task_rooms)
         if closed and closed[0].region_id == here and (self.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
@@ -393,8 +412,14 @@ class GroundedPlanner:
             return self._explore_step(region, note)
         if closed:
             return self._open_to_look(closed[0].label, held, note)
-        doors = sorted((o for o in graph.objects.values() if o.category == "door" and o.open is False
-                        and o.label not in self.dropped), key=lambda o: math.dist(o.position[:2], self.body.xy))
+        doors = sorted(
+            (
+                o
+                for o in graph.objects.values()
+                if o.category == "door" and o.open is False and o.label not in self.dropped
+            ),
+            key=lambda o: math.dist(o.position[:2], self.body.xy),
+        )
         if doors:
             return self._open_to_look(doors[0].label, held, note)
         if region is not None:
@@ -417,9 +442,14 @@ class GroundedPlanner:
             return None
         path = self.body.trajectory
         candidates = [
-            o for o in self._graph().objects.values()
-            if o.region_id in rooms and o.open is None and is_surface(o.category) and o.label not in self.looked_at
-            and o.label not in self.dropped and _far_corner_gap(o, path) > LOOK_AT_M
+            o
+            for o in self._graph().objects.values()
+            if o.region_id in rooms
+            and o.open is None
+            and is_surface(o.category)
+            and o.label not in self.looked_at
+            and o.label not in self.dropped
+            and _far_corner_gap(o, path) > LOOK_AT_M
         ]
         xy = self.body.xy
         return min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label)).label if candidates else None
@@ -442,8 +472,15 @@ class GroundedPlanner:
             kind = self.room_types.get(rid)
             like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
             productive = self.explored[rid] > 0 and self.fruitless[rid] == 0
-            return (self._stale(rid), -like, rid not in task_rooms, not productive, self.explored[rid],
-                    math.dist(graph.regions[rid].centroid, self.body.xy), rid)
+            return (
+                self._stale(rid),
+                -like,
+                rid not in task_rooms,
+                not productive,
+                self.explored[rid],
+                math.dist(graph.regions[rid].centroid, self.body.xy),
+                rid,
+            )
 
         open_regions = [rid for rid, r in graph.regions.items() if r.frontiers]
         return min(open_regions, key=score) if open_regions else None
@@ -462,8 +499,11 @@ class GroundedPlanner:
 
     def _explore_step(self, region: str, note: str) -> _Step:
         far = far_frontiers(self._graph().frontiers(region), self.body.trajectory)
-        return _Step(HighLevelAction("explore", (self.names[region],), note=note), region=region,
-                     frontiers=self._informative(far))
+        return _Step(
+            HighLevelAction("explore", (self.names[region],), note=note),
+            region=region,
+            frontiers=self._informative(far),
+        )
 
     def _informative(self, frontiers: tuple[XY, ...]) -> tuple[XY, ...]:
         """The frontiers from which the most unknown floor lies in sensor range (``INFORMATIVE_SHARE``):
@@ -471,8 +511,9 @@ class GroundedPlanner:
         occupancy = self._graph().occupancy
         if occupancy is None or len(frontiers) < 2:
             return frontiers
-        gain = visible_unknown_area(occupancy.grid, occupancy.frame, np.asarray(frontiers),
-                                    range_m=self.body.builder.config.max_range_m)
+        gain = visible_unknown_area(
+            occupancy.grid, occupancy.frame, np.asarray(frontiers), range_m=self.body.builder.config.max_range_m
+        )
         return tuple(f for f, g in zip(frontiers, gain) if g >= INFORMATIVE_SHARE * gain.max())
 
     def _put_down(self, held: str) -> _Step:
@@ -489,9 +530,14 @@ class GroundedPlanner:
         """Whether a goal literal wants ``held`` off the floor of ``region`` (``not ontop`` a floor scope
         that names no room or names this room's type)."""
         kind = self.room_types.get(region or "")
-        return any(lit.negated and lit.predicate == "ontop" and self.goal.is_floor(lit.args[1])
-                   and self.bound.get(lit.args[0]) == held and self.goal.floor_rooms[lit.args[1]] in (None, kind)
-                   for lit in self.literals)
+        return any(
+            lit.negated
+            and lit.predicate == "ontop"
+            and self.goal.is_floor(lit.args[1])
+            and self.bound.get(lit.args[0]) == held
+            and self.goal.floor_rooms[lit.args[1]] in (None, kind)
+            for lit in self.literals
+        )
 
     def _placed_elsewhere(self, scope: str) -> bool:
         """Whether a goal literal places ``scope`` somewhere (which takes it off any floor it must leave)."""
@@ -501,9 +547,16 @@ class GroundedPlanner:
         """The nearest reachable observed furniture to put ``held`` on top of: low enough to reach
         (``PUT_DOWN_MAX_TOP_M``), not closed, not given up on; in the robot's room first."""
         here = self._graph().robot.region_id
-        spots = [o for label in self._reachable() if label not in self.dropped and label != held
-                 and is_furniture((o := self.seen[label]).category) and o.category != "door"
-                 and o.bbox.max[2] <= PUT_DOWN_MAX_TOP_M and o.open is not False]
+        spots = [
+            o
+            for label in self._reachable()
+            if label not in self.dropped
+            and label != held
+            and is_furniture((o := self.seen[label]).category)
+            and o.category != "door"
+            and o.bbox.max[2] <= PUT_DOWN_MAX_TOP_M
+            and o.open is not False
+        ]
         if not spots:
             return None
         return min(spots, key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label)).label

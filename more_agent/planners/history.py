@@ -13,8 +13,14 @@ def append_action(history: list[ActionRecord], action: HighLevelAction, result: 
     next prompt shows (``skill: success|failure; reason``). The feedback is clipped: it reaches every
     later prompt through the history."""
     feedback = clip(result.feedback, MAX_FEEDBACK_CHARS)
-    history.append(ActionRecord(
-        step=len(history), name=action.name, arguments=list(action.arguments), ok=result.ok, reason=result.reason,
-        feedback=feedback,
-    ))
+    history.append(
+        ActionRecord(
+            step=len(history),
+            name=action.name,
+            arguments=list(action.arguments),
+            ok=result.ok,
+            reason=result.reason,
+            feedback=feedback,
+        )
+    )
     return f"{action.name}: {'success' if result.ok else 'failure'}; {feedback}"

@@ -52,7 +52,9 @@ class LanguageOptions(BaseModel):
     spatial_relations: bool = Field(
         default=True, description="Add 'inside X' / 'on top of X' relations among observed objects."
     )
-    floors: bool = Field(default=True, description="List each room's floor ('floor') so goals on floors can be expressed.")
+    floors: bool = Field(
+        default=True, description="List each room's floor ('floor') so goals on floors can be expressed."
+    )
 
 
 @dataclass(frozen=True)
@@ -186,7 +188,9 @@ def scene_view(graph: SceneGraph, options: LanguageOptions, names: Mapping[str, 
         rooms.append(RoomText(name=names[rid], region_id=rid, objects=entries, unexplored=bool(region.frontiers)))
     robot_room = names.get(graph.robot.region_id or "", UNKNOWN_PLACE)
     return SceneView(
-        rooms=tuple(rooms), robot_room=robot_room, held=shown[held.id] if held is not None else None,
+        rooms=tuple(rooms),
+        robot_room=robot_room,
+        held=shown[held.id] if held is not None else None,
         held_id=held.id if held is not None else None,
     )
 

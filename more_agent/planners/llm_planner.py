@@ -65,7 +65,6 @@ from more_agent.vocabulary import FLOOR, ROOM_TYPES
 log = logging.getLogger(__name__)
 
 
-
 class LLMPlannerConfig(BaseModel):
     """What distinguishes MORE from the MoMa-LLM baselines, and the knobs they share."""
 
@@ -74,14 +73,18 @@ class LLMPlannerConfig(BaseModel):
     name: str = Field(description="Planner name as registered, e.g. 'more'.")
     filtering: bool = Field(description="Ask the LLM for the task-relevant subgraph before planning (MORE).")
     language: LanguageOptions = Field(description="Instance ids and spatial relations in the scene text.")
-    max_reasks: int = Field(default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action.")
+    max_reasks: int = Field(
+        default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action."
+    )
     room_types: tuple[str, ...] = Field(default=ROOM_TYPES, description="Room labels the room classifier chooses from.")
     policy: PolicyConfig = Field(default_factory=PolicyConfig, description="Subpolicy knobs.")
     mapping: MappingConfig = Field(default_factory=MappingConfig, description="Mapping and scene-graph knobs.")
 
 
 PLANNER_CONFIGS: dict[str, LLMPlannerConfig] = {
-    "more": LLMPlannerConfig(name="more", filtering=True, language=LanguageOptions(instance_ids=True, spatial_relations=True)),
+    "more": LLMPlannerConfig(
+        name="more", filtering=True, language=LanguageOptions(instance_ids=True, spatial_relations=True)
+    ),
     "moma-llm": LLMPlannerConfig(
         name="moma-llm", filtering=False, language=LanguageOptions(instance_ids=False, spatial_relations=False)
     ),
@@ -125,7 +128,8 @@ class LLMPlanner:
         self.calls = CallLog()
         """Every LLM call (room labels, filter, plan, re-asks): the episode's usage, the step's exchanges."""
         self.clients = LLMClients(
-            plan=RecordingClient(clients.plan, self.calls), room=RecordingClient(clients.room, self.calls),
+            plan=RecordingClient(clients.plan, self.calls),
+            room=RecordingClient(clients.room, self.calls),
             spec=clients.spec,
         )
         self.body: Embodiment | None = None
@@ -142,8 +146,9 @@ class LLMPlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
-        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping,
-                               on_frame=context.on_frame)
+        self.body = Embodiment(
+            context.instance.world, config=self.config.policy, mapping=self.config.mapping, on_frame=context.on_frame
+        )
         self.task = context.instance.description
         self.history, self.history_mode, self.feedback = [], context.history, ""
         self.calls.new_episode()
@@ -167,15 +172,23 @@ class LLMPlanner:
         view = self._view()
         planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
         messages = plan_messages(
-            task=self.task, scene=planning_view.text(), robot_room=view.robot_room, held_object=view.held,
-            history=self.history, feedback=self.feedback, history_mode=self.history_mode,
+            task=self.task,
+            scene=planning_view.text(),
+            robot_room=view.robot_room,
+            held_object=view.held,
+            history=self.history,
+            feedback=self.feedback,
+            history_mode=self.history_mode,
         )
         rooms, objects = [r.name for r in view.rooms], view.object_names()
         try:
             answer = ask_validated(
-                self.clients.plan, messages, PlanAnswer,
+                self.clients.plan,
+                messages,
+                PlanAnswer,
                 lambda a: parse_plan_answer(a, SKILLS, rooms, objects),
-                max_reasks=self.config.max_reasks, purpose="plan",
+                max_reasks=self.config.max_reasks,
+                purpose="plan",
             )
         except InvalidAnswer as e:
             return HighLevelAction(name=INVALID, note=e.reason)
@@ -193,8 +206,11 @@ class LLMPlanner:
         view = self._view()
         planning = self.planning_view or view
         log_line = {
-            "action": self.history[-1].model_dump(), "scene": view.text(), "planning_scene": planning.text(),
-            "robot_room": view.robot_room, "exchanges": [e.to_json() for e in self.calls.exchanges],
+            "action": self.history[-1].model_dump(),
+            "scene": view.text(),
+            "planning_scene": planning.text(),
+            "robot_room": view.robot_room,
+            "exchanges": [e.to_json() for e in self.calls.exchanges],
         }
         return StepTrace(log=log_line, graph=self.graph)
 
@@ -217,9 +233,12 @@ class LLMPlanner:
                 continue
             try:
                 answer = ask_validated(
-                    self.clients.room, room_messages(names, self.config.room_types), RoomLabelAnswer,
+                    self.clients.room,
+                    room_messages(names, self.config.room_types),
+                    RoomLabelAnswer,
                     lambda a: parse_room_label(a, self.config.room_types),
-                    max_reasks=self.config.max_reasks, purpose="room",
+                    max_reasks=self.config.max_reasks,
+                    purpose="room",
                 )
             except InvalidAnswer as e:
                 log.info("room label of %s stays unknown: %s", rid, e.reason)
@@ -229,12 +248,16 @@ class LLMPlanner:
 
     def _filter(self, view: SceneView) -> SceneView:
         """The task-relevant subgraph (paper Sec. III-B); the full view when nothing to filter or no usable answer."""
-        return filter_view(self.clients.plan, self.task, view, max_reasks=self.config.max_reasks, always={view.robot_room})
+        return filter_view(
+            self.clients.plan, self.task, view, max_reasks=self.config.max_reasks, always={view.robot_room}
+        )
 
     def _run(self, action: HighLevelAction) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}")
+            return ActionResult(
+                ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}"
+            )
         body, graph, view = self._body(), self._graph(), self._view()
         params = SKILLS_BY_NAME[action.name].params
         if not params:  # done
@@ -244,8 +267,9 @@ class LLMPlanner:
             return run_skill(body, graph, action.name, Area(room, view.room(room).region_id))
         target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
         if target is None:
-            return ActionResult(ok=False, reason=FailureReason.UNKNOWN_OBJECT,
-                                feedback=f"unknown object {action.arguments[1]}")
+            return ActionResult(
+                ok=False, reason=FailureReason.UNKNOWN_OBJECT, feedback=f"unknown object {action.arguments[1]}"
+            )
         return run_skill(body, graph, action.name, target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
@@ -289,14 +313,20 @@ def filter_view(
         return view
     try:
         answer = ask_validated(
-            client, filter_messages(task, view.text()), FilterAnswer,
-            lambda a: parse_filter_answer(a, view.names()), max_reasks=max_reasks, purpose="filter",
+            client,
+            filter_messages(task, view.text()),
+            FilterAnswer,
+            lambda a: parse_filter_answer(a, view.names()),
+            max_reasks=max_reasks,
+            purpose="filter",
         )
     except InvalidAnswer as e:
         log.info("filter answer unusable, keeping the full scene: %s", e.reason)
         return view
     if answer.value.unknown_rooms or answer.value.unknown_objects:
-        log.warning("filter answer named unknown rooms %s / objects %s: ignored",
-                    clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
-                    clip(str(answer.value.unknown_objects), MAX_NAME_CHARS))
+        log.warning(
+            "filter answer named unknown rooms %s / objects %s: ignored",
+            clip(str(answer.value.unknown_rooms), MAX_NAME_CHARS),
+            clip(str(answer.value.unknown_objects), MAX_NAME_CHARS),
+        )
     return view.filtered(answer.value, always=always)

@@ -69,6 +69,7 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     likewise ``inside(a, b)`` with ``inside(a, c)`` becomes ``inside(b, c)``. Placing ``a`` on ``c``
     directly would undo the primary literal.
     """
+
     def placement(lit: Literal) -> bool:
         return lit.predicate in RELATIONS and not lit.negated and lit.args[0] != ROBOT_NAME
 
@@ -89,11 +90,13 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
 
 def choose_option(goals: GoalChecker, world: World, exclude: Collection[int] = frozenset()) -> int | None:
     """The ground goal option (not in ``exclude``) with the fewest literals the oracle cannot achieve, then the fewest unmet."""
+
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)
         unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
         unmet = sum(unsupported_reason(world, lit) is None and not lit.holds(world) for lit in lits)
         return unsupported, unmet, i
+
     candidates = [i for i in range(goals.n_options) if i not in exclude]
     return min(candidates, key=cost) if candidates else None
 
@@ -179,7 +182,9 @@ class OraclePlanner:
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
             why = self._last_failure[key][0]
-            note = f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
+            note = (
+                f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
+            )
             return HighLevelAction(DONE, gave_up=note)
         return action
 
@@ -281,7 +286,9 @@ class OraclePlanner:
         """
         world = self._world
         held = world.robot.held
-        avoid = {lit.args[1] for lit in self._literals if lit.negated and lit.predicate == "ontop" and lit.args[0] == held}
+        avoid = {
+            lit.args[1] for lit in self._literals if lit.negated and lit.predicate == "ontop" and lit.args[0] == held
+        }
         room = world.room_at(world.robot.x, world.robot.y)
 
         def rank(o: WorldObject) -> tuple[int, float]:
@@ -289,10 +296,20 @@ class OraclePlanner:
             return tier, distance_to_footprint(world, o.name)
 
         spots = sorted(
-            (o for o in world.objects.values() if o.name not in avoid and (
-                o.kind == "floor" or (o.kind == "furniture" and o.room == room and o.top <= PUT_DOWN_MAX_TOP_M
-                                      and not (o.openable and not o.is_open))
-            )),
+            (
+                o
+                for o in world.objects.values()
+                if o.name not in avoid
+                and (
+                    o.kind == "floor"
+                    or (
+                        o.kind == "furniture"
+                        and o.room == room
+                        and o.top <= PUT_DOWN_MAX_TOP_M
+                        and not (o.openable and not o.is_open)
+                    )
+                )
+            ),
             key=rank,
         )
         actions = [HighLevelAction("go_to_and_place_ontop", (o.name,), note="free the hand") for o in spots]

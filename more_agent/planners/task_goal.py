@@ -71,8 +71,10 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
     if intended != instance.definition.goal:
         goals = GoalChecker(instance, goal=intended)
     options = tuple(
-        tuple(Literal(lit.predicate, tuple(to_scope.get(a, a) for a in lit.args), lit.negated)
-              for lit in goals.ground_literals(i))
+        tuple(
+            Literal(lit.predicate, tuple(to_scope.get(a, a) for a in lit.args), lit.negated)
+            for lit in goals.ground_literals(i)
+        )
         for i in range(goals.n_options)
     )
     described = described_scopes(instance)
@@ -90,12 +92,14 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
             floors[scope] = match.group(1).replace(" ", "_") if match else None
             continue
         own = synset.split(".")[0]
-        categories[scope] = frozenset(c for c in scope_categories(scope)
-                                      if scope not in moved or c == own or not catalog.is_scene_fixture(c))
+        categories[scope] = frozenset(
+            c for c in scope_categories(scope) if scope not in moved or c == own or not catalog.is_scene_fixture(c)
+        )
         if scope in described:
             named[scope] = instance.label(scope)
-    return TaskGoal(options=options, categories=categories, named=named, floor_rooms=floors, robot=robot,
-                    moved=frozenset(moved))
+    return TaskGoal(
+        options=options, categories=categories, named=named, floor_rooms=floors, robot=robot, moved=frozenset(moved)
+    )
 
 
 def intended_goal(parsed: list[Any]) -> list[Any]:

@@ -44,7 +44,9 @@ class MemoryConfig(BaseModel):
         default=8, ge=1, description="Most buffer frames in one VLM request (the buffer is subsampled beyond)."
     )
     occlusion_margin_m: float = Field(
-        default=0.3, ge=0, description="A point counts as seen in a frame if the frame's depth there reaches within this of it.",
+        default=0.3,
+        ge=0,
+        description="A point counts as seen in a frame if the frame's depth there reaches within this of it.",
     )
 
 
@@ -102,9 +104,14 @@ def memory_frame(frame: Frame, *, index: int, step: int) -> MemoryFrame:
     """A buffer entry for ``frame`` (arrays zlib-compressed: about 1.5 ms and a few tens of kB per frame)."""
     counts = np.bincount(frame.instance.ravel())
     return MemoryFrame(
-        index=index, step=step, pose=camera_pose(frame.T_world_cam),
-        instance_ids=frozenset(int(i) for i in np.flatnonzero(counts) if i != 0), K=frame.K.copy(),
-        T_world_cam=frame.T_world_cam.copy(), shape=frame.instance.shape, _rgb=_packed(frame.rgb, np.uint8),
+        index=index,
+        step=step,
+        pose=camera_pose(frame.T_world_cam),
+        instance_ids=frozenset(int(i) for i in np.flatnonzero(counts) if i != 0),
+        K=frame.K.copy(),
+        T_world_cam=frame.T_world_cam.copy(),
+        shape=frame.instance.shape,
+        _rgb=_packed(frame.rgb, np.uint8),
         _instance=_packed(frame.instance, np.int32),
         _depth=_packed(frame.depth[::DEPTH_STRIDE, ::DEPTH_STRIDE], np.float16),
     )

@@ -89,13 +89,24 @@ def frame_captions(objects_per_frame: Sequence[Sequence[str]]) -> list[str]:
 
 
 def step_messages(
-    *, task: str, view: Picture, objects: Sequence[str], held: str | None, history: Sequence[Any], feedback: str,
+    *,
+    task: str,
+    view: Picture,
+    objects: Sequence[str],
+    held: str | None,
+    history: Sequence[Any],
+    feedback: str,
     history_mode: HistoryMode = DEFAULT_HISTORY,
 ) -> list[ChatMessage]:
     """The step decision: task, annotated current view and its marked objects, memories, skills."""
     messages = render_prompt(
-        "bumble_plan", task=task, skills=skill_api_text(SKILLS, vlm=True), objects=object_list(objects),
-        held_object=held or "nothing", history=history_text(history, history_mode), feedback=feedback or "none",
+        "bumble_plan",
+        task=task,
+        skills=skill_api_text(SKILLS, vlm=True),
+        objects=object_list(objects),
+        held_object=held or "nothing",
+        history=history_text(history, history_mode),
+        feedback=feedback or "none",
     )
     return with_pictures(messages, [view])
 

@@ -19,7 +19,19 @@ from more_agent.scene_graph.model import (
 from more_agent.scene_graph.relations import spatial_relations
 
 __all__ = [
-    "SCHEMA_VERSION", "Box3D", "InstanceInfo", "Layer", "NavGraphData", "ObjectNode", "OccupancyMap",
-    "RegionNode", "Relation", "RobotNode", "SceneGraph", "SceneGraphBuilder", "load_scene_graph",
-    "spatial_relations", "to_networkx",
+    "SCHEMA_VERSION",
+    "Box3D",
+    "InstanceInfo",
+    "Layer",
+    "NavGraphData",
+    "ObjectNode",
+    "OccupancyMap",
+    "RegionNode",
+    "Relation",
+    "RobotNode",
+    "SceneGraph",
+    "SceneGraphBuilder",
+    "load_scene_graph",
+    "spatial_relations",
+    "to_networkx",
 ]

@@ -58,9 +58,13 @@ class SceneGraphBuilder:
         self.class_names = list(class_names)
         self.voxels = VoxelMap(
             free_class_ids=[i for i, n in enumerate(self.class_names) if n in FREE_SPACE_CLASSES],
-            resolution_m=cfg.resolution_m, z_min_m=cfg.z_min_m, z_max_m=cfg.z_max_m,
-            bev_max_height_m=cfg.bev_max_height_m, max_range_m=cfg.max_range_m,
-            carve_stride_px=cfg.carve_stride_px, initial_extent_m=cfg.initial_extent_m,
+            resolution_m=cfg.resolution_m,
+            z_min_m=cfg.z_min_m,
+            z_max_m=cfg.z_max_m,
+            bev_max_height_m=cfg.bev_max_height_m,
+            max_range_m=cfg.max_range_m,
+            carve_stride_px=cfg.carve_stride_px,
+            initial_extent_m=cfg.initial_extent_m,
         )
         self._structure_ids = np.array([i for i, n in enumerate(self.class_names) if n in STRUCTURE_CATEGORIES])
         self._instances: dict[int, InstanceInfo] = {}
@@ -103,7 +107,12 @@ class SceneGraphBuilder:
             if info.held:
                 self._remembered.discard(iid)
                 self._glimpsed.pop(iid, None)
-            if info.category == "door" and previous is not None and previous.open is not None and info.open != previous.open:
+            if (
+                info.category == "door"
+                and previous is not None
+                and previous.open is not None
+                and info.open != previous.open
+            ):
                 removed = self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks
                 if len(removed):  # ... but the door is still there, in the state the robot knows, until seen again
                     self._set_box(iid, removed)
@@ -184,16 +193,24 @@ class SceneGraphBuilder:
             self._boxes[i] = (lo + shift, hi + shift)
         centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
-        rg = region_graph(occ, grid, door_points=doors, objects_xy=centres[:, :2], viewpoints_xy=viewpoints,
-                          blocked=blocked, config=self.config)
+        rg = region_graph(
+            occ,
+            grid,
+            door_points=doors,
+            objects_xy=centres[:, :2],
+            viewpoints_xy=viewpoints,
+            blocked=blocked,
+            config=self.config,
+        )
         region_ids = self._stable_ids(rg.graph, rg.labels)
         keep = self._robot_component(rg.graph, robot, blocked, grid, self._retraceable(path_xy, occ, grid))
         frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
         return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, grid)
 
     # ---------------------------------------------------------------- helpers
-    def _glimpse(self, depth: np.ndarray, instance: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray,
-                 held: Sequence[int]) -> None:
+    def _glimpse(
+        self, depth: np.ndarray, instance: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray, held: Sequence[int]
+    ) -> None:
         """Box the small instances in view from their own pixels. A small item on a support shares its
         voxels with the support's surface (7.5 cm voxels, an egg is 5 cm tall), and the surface's hits
         overwrite it: without this the map loses it even while the robot looks at it."""
@@ -206,7 +223,7 @@ class SceneGraphBuilder:
         v, u = np.nonzero(valid & np.isin(instance, small))
         d = depth[v, u].astype(float)
         cam = np.stack([(u + 0.5 - K[0, 2]) / K[0, 0] * d, (v + 0.5 - K[1, 2]) / K[1, 1] * d, d], axis=1)
-        inside = np.einsum("ij,ij->i", cam, cam) <= self.config.max_range_m ** 2
+        inside = np.einsum("ij,ij->i", cam, cam) <= self.config.max_range_m**2
         pts = cam[inside] @ T_world_cam[:3, :3].T + T_world_cam[:3, 3]
         ids = instance[v, u][inside]
         half = self.config.resolution_m / 2
@@ -244,7 +261,7 @@ class SceneGraphBuilder:
             path, near = path[hit], near[hit]
             elsewhere = comp[near] != comp[node]
             for p, i in zip(path[elsewhere], near[elsewhere]):
-                if int(comp[i]) not in keep and line_of_sight(p, graph.xy[i:i + 1], blocked, grid)[0]:
+                if int(comp[i]) not in keep and line_of_sight(p, graph.xy[i : i + 1], blocked, grid)[0]:
                     keep.add(int(comp[i]))
         return np.isin(comp, sorted(keep))
 
@@ -293,8 +310,17 @@ class SceneGraphBuilder:
             ids.append(rid)
         return ids
 
-    def _assemble(self, rg: RegionGraph, region_ids: list[str], keep: np.ndarray, objects: list[int],
-                  frontier_node: np.ndarray, robot: np.ndarray, occ: np.ndarray, grid: Grid) -> SceneGraph:
+    def _assemble(
+        self,
+        rg: RegionGraph,
+        region_ids: list[str],
+        keep: np.ndarray,
+        objects: list[int],
+        frontier_node: np.ndarray,
+        robot: np.ndarray,
+        occ: np.ndarray,
+        grid: Grid,
+    ) -> SceneGraph:
         """Put the pipeline's graph, reduced to the ``keep`` node mask, into the data model."""
         graph, labels = rg.graph, rg.labels
         sub_index = np.cumsum(keep) - 1
@@ -318,12 +344,17 @@ class SceneGraphBuilder:
             members = np.flatnonzero(keep & (labels == lab))
             fr = [tuple(map(float, p)) for p, n in zip(rg.frontier_xy, frontier_node) if n >= 0 and labels[n] == lab]
             regions[rid] = RegionNode(
-                id=rid, room_label=self._room_labels.get(rid), centroid=tuple(map(float, graph.xy[members].mean(0))),
-                nav_nodes=sub_index[members].tolist(), frontiers=fr,
+                id=rid,
+                room_label=self._room_labels.get(rid),
+                centroid=tuple(map(float, graph.xy[members].mean(0))),
+                nav_nodes=sub_index[members].tolist(),
+                frontiers=fr,
             )
 
-        relations = self._relations([o for o in obj_nodes.values() if o.category != "door" and not o.held],
-                                    held={o.id for o in obj_nodes.values() if o.held})
+        relations = self._relations(
+            [o for o in obj_nodes.values() if o.category != "door" and not o.held],
+            held={o.id for o in obj_nodes.values() if o.held},
+        )
 
         robot_node = -1
         labelled_kept = np.flatnonzero(keep & (labels >= 0))
@@ -332,12 +363,20 @@ class SceneGraphBuilder:
         self._step += 1
         return SceneGraph(
             step=self._step - 1,
-            robot=RobotNode(position=(float(robot[0]), float(robot[1])),
-                            region_id=region_ids[labels[robot_node]] if robot_node >= 0 else None),
-            regions=regions, objects=obj_nodes, relations=relations,
-            nav=NavGraphData(node_xy=graph.xy[keep], edges=sub_index[graph.edges[emask]],
-                             weights=graph.weights[emask], door_edges=rg.cut[emask],
-                             node_region=node_region),
+            robot=RobotNode(
+                position=(float(robot[0]), float(robot[1])),
+                region_id=region_ids[labels[robot_node]] if robot_node >= 0 else None,
+            ),
+            regions=regions,
+            objects=obj_nodes,
+            relations=relations,
+            nav=NavGraphData(
+                node_xy=graph.xy[keep],
+                edges=sub_index[graph.edges[emask]],
+                weights=graph.weights[emask],
+                door_edges=rg.cut[emask],
+                node_region=node_region,
+            ),
             occupancy=OccupancyMap(grid=occ, origin_xy=grid.origin_xy, resolution_m=grid.resolution_m),
         )
 
@@ -353,17 +392,26 @@ class SceneGraphBuilder:
                 relations.append(Relation(subject=o.id, predicate=rests[0], object=rests[1]))
         boxes_min = np.array([o.bbox.min for o in placed]).reshape(-1, 3)
         boxes_max = np.array([o.bbox.max for o in placed]).reshape(-1, 3)
-        relations += [Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
-                      for a, p, b in spatial_relations(boxes_min, boxes_max, tol_m=self.config.relation_tol_m,
-                                                       inside_fraction=self.config.inside_fraction)
-                      if self._instances[placed[a].instance_id].rests is None]
+        relations += [
+            Relation(subject=placed[a].id, predicate=p, object=placed[b].id)
+            for a, p, b in spatial_relations(
+                boxes_min, boxes_max, tol_m=self.config.relation_tol_m, inside_fraction=self.config.inside_fraction
+            )
+            if self._instances[placed[a].instance_id].rests is None
+        ]
         return relations
 
     def _object_node(self, iid: int, region_id: str | None) -> ObjectNode:
         info = self._instances[iid]
         lo, hi = self._boxes[iid]
         return ObjectNode(
-            id=info.label, category=info.category, instance_id=iid, label=info.label, region_id=region_id,
-            position=tuple(map(float, (lo + hi) / 2)), bbox=Box3D(min=tuple(map(float, lo)), max=tuple(map(float, hi))),
-            open=info.open, held=info.held,
+            id=info.label,
+            category=info.category,
+            instance_id=iid,
+            label=info.label,
+            region_id=region_id,
+            position=tuple(map(float, (lo + hi) / 2)),
+            bbox=Box3D(min=tuple(map(float, lo)), max=tuple(map(float, hi))),
+            open=info.open,
+            held=info.held,
         )

@@ -167,8 +167,10 @@ class SceneGraph(_Model):
             raise ValueError(f"the robot holds one object at most, not {held}")
         for o in self.objects.values():
             if o.held != (o.region_id is None) or not (o.held or o.region_id in self.regions):
-                raise ValueError(f"object {o.id!r}: held={o.held} with region {o.region_id!r}; a held object has "
-                                 "no region, any other one a region of the graph")
+                raise ValueError(
+                    f"object {o.id!r}: held={o.held} with region {o.region_id!r}; a held object has "
+                    "no region, any other one a region of the graph"
+                )
         return self
 
     def objects_in(self, region_id: str) -> list[ObjectNode]:

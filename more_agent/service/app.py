@@ -25,7 +25,7 @@ from more_agent.records import ActionRecord
 from more_agent.redaction import redact
 from more_agent.service.decision import Decision, decide
 
-MAX_BODY_BYTES = 8 * 2 ** 20
+MAX_BODY_BYTES = 8 * 2**20
 """Largest request body accepted (a scene graph of a large building is a few hundred kB)."""
 
 MAX_TASK_CHARS = 4000
@@ -42,8 +42,11 @@ class PlanRequest(BaseModel):
     graph: dict[str, Any] | None = Field(None, description="MORE's scene graph JSON (scene_graph.json of ingest).")
     spark_dsg: dict[str, Any] | None = Field(None, description="A Spark-DSG graph as its JSON (what Hydra saves).")
     label_map: dict[int, str] | None = Field(None, description="Spark-DSG graphs: semantic label -> class name.")
-    history: list[ActionRecord] = Field(default_factory=list, max_length=MAX_HISTORY,
-                                        description="The actions so far with their outcomes, oldest first.")
+    history: list[ActionRecord] = Field(
+        default_factory=list,
+        max_length=MAX_HISTORY,
+        description="The actions so far with their outcomes, oldest first.",
+    )
     planner: Literal["more", "moma-llm", "moma-llm-sr"] = Field("more", description="LLM planner.")
 
 
@@ -83,8 +86,13 @@ class _TooLarge(Exception):
 
 async def _too_large(send: Any, limit: int) -> None:
     body = f'{{"detail": "request body over {limit} bytes"}}'.encode()
-    await send({"type": "http.response.start", "status": 413,
-                "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]})
+    await send(
+        {
+            "type": "http.response.start",
+            "status": 413,
+            "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())],
+        }
+    )
     await send({"type": "http.response.body", "body": body})
 
 
@@ -96,8 +104,9 @@ def create_app(clients: LLMClients, *, max_body_bytes: int = MAX_BODY_BYTES) -> 
     """The FastAPI app deciding with ``clients`` (module docstring)."""
     fastapi = require("fastapi", "serve")
     responses = require("fastapi.responses", "serve")
-    app = fastapi.FastAPI(title="more-agent", summary="MORE's filter and planner: one decision per robot step.",
-                          version="1")
+    app = fastapi.FastAPI(
+        title="more-agent", summary="MORE's filter and planner: one decision per robot step.", version="1"
+    )
     lock = threading.Lock()
 
     @app.exception_handler(UserError)
@@ -107,8 +116,9 @@ def create_app(clients: LLMClients, *, max_body_bytes: int = MAX_BODY_BYTES) -> 
     @app.exception_handler(LLMError)
     async def llm_failed(request: Any, exc: LLMError) -> Any:
         status = 504 if isinstance(exc, LLMTimeout) else 502
-        return responses.JSONResponse(status_code=status, content={"detail": f"LLM error ({type(exc).__name__}): "
-                                                                              f"{_detail(exc)}"})
+        return responses.JSONResponse(
+            status_code=status, content={"detail": f"LLM error ({type(exc).__name__}): {_detail(exc)}"}
+        )
 
     @app.get("/v1/health")
     def health() -> dict[str, str]:

@@ -57,8 +57,9 @@ def feedback_line(history: Sequence[ActionRecord]) -> str:
     return f"{last.name}: {'success' if last.ok else 'failure'}; {last.feedback}"
 
 
-def decide(graph: SceneGraph, task: str, history: Sequence[ActionRecord], clients: LLMClients, *,
-           planner: str = "more") -> Decision:
+def decide(
+    graph: SceneGraph, task: str, history: Sequence[ActionRecord], clients: LLMClients, *, planner: str = "more"
+) -> Decision:
     """One decision of the LLM planner ``planner`` on ``graph`` for ``task`` after ``history``."""
     agent = LLMPlanner(PLANNER_CONFIGS[planner], clients)
     agent.calls.new_episode()
@@ -70,8 +71,13 @@ def decide(graph: SceneGraph, task: str, history: Sequence[ActionRecord], client
     action = agent.decide()
     planning = agent.planning_view or agent.view
     return Decision(
-        skill=action.name, arguments=list(action.arguments), reasoning=action.note, scene=agent.view.text(),
-        filtered_scene=planning.text(), room_labels=labels,
-        regions={room.name: room.region_id for room in agent.view.rooms}, llm=clients.spec, llm_usage=agent.llm_usage(),
+        skill=action.name,
+        arguments=list(action.arguments),
+        reasoning=action.note,
+        scene=agent.view.text(),
+        filtered_scene=planning.text(),
+        room_labels=labels,
+        regions={room.name: room.region_id for room in agent.view.rooms},
+        llm=clients.spec,
+        llm_usage=agent.llm_usage(),
     )
-

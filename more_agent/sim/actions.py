@@ -101,7 +101,9 @@ def _check_target(world: World, name: str) -> WorldObject | ActionResult:
     obj = world.get(name)
     hider = world.enclosing_closed_container(name)
     if hider is not None:
-        return _fail(FailureReason.HIDDEN, f"{_label(obj)} is inside closed {_label(hider)}; must open {_label(hider)} first")
+        return _fail(
+            FailureReason.HIDDEN, f"{_label(obj)} is inside closed {_label(hider)}; must open {_label(hider)} first"
+        )
     return obj
 
 
@@ -178,8 +180,10 @@ def approach_rounds(world: World, name: str, config: NavConfig = DEFAULT_NAV) ->
     """Free base positions within reach of ``name``, in rounds (circle first, then support rings)."""
     grid = nav_grid(world, config)
     box = reach_box(world, name)
-    rounds = [[p for p in poses if _point_to_box(p, box) <= REACH_M and grid.is_free(*p)]
-              for poses in candidate_poses(world, name)]
+    rounds = [
+        [p for p in poses if _point_to_box(p, box) <= REACH_M and grid.is_free(*p)]
+        for poses in candidate_poses(world, name)
+    ]
     return [r for r in rounds if r]
 
 
@@ -211,7 +215,8 @@ def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> Act
     door = blocking_door(world, start, [p for poses in rounds for p in poses], config)
     if door is not None:
         return _fail(
-            FailureReason.PATH_BLOCKED_BY_DOOR, f"the way to {_label(obj)} is blocked by closed {_label(world.get(door))}",
+            FailureReason.PATH_BLOCKED_BY_DOOR,
+            f"the way to {_label(obj)} is blocked by closed {_label(world.get(door))}",
             blocking=door,
         )
     return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {_label(obj)}")
@@ -337,6 +342,10 @@ def go_to_and(world: World, verb: str, name: str, config: NavConfig = DEFAULT_NA
         return nav
     result = act(world, name)
     return ActionResult(
-        ok=result.ok, reason=result.reason, feedback=result.feedback,
-        low_level_steps=nav.low_level_steps + result.low_level_steps, path=nav.path, blocking=result.blocking,
+        ok=result.ok,
+        reason=result.reason,
+        feedback=result.feedback,
+        low_level_steps=nav.low_level_steps + result.low_level_steps,
+        path=nav.path,
+        blocking=result.blocking,
     )

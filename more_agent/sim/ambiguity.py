@@ -90,17 +90,29 @@ def ambiguous_in(world: World, definition: TaskDefinition, scope: Mapping[str, s
     room_types = {r.id: r.type for r in world.scene.rooms}
     out: set[str] = set()
     for group in scope_groups(goal, definition.objects):
-        members = [s for s in group.scopes if s in scope and scope[s] in world.objects
-                   and world.objects[scope[s]].kind != "floor"]
+        members = [
+            s
+            for s in group.scopes
+            if s in scope and scope[s] in world.objects and world.objects[scope[s]].kind != "floor"
+        ]
         unnamed = [s for s in members if s not in described]
         is_moved = any(s in moved for s in members) or (group.quantifier is not None and _variable_moved(goal, members))
-        if not unnamed or (group.quantifier == "forall" and not is_moved) or (group.quantifier == "exists" and len(unnamed) < len(members)):
+        if (
+            not unnamed
+            or (group.quantifier == "forall" and not is_moved)
+            or (group.quantifier == "exists" and len(unnamed) < len(members))
+        ):
             continue
         own = {scope[s] for s in members}
         categories = scope_categories(members[0])
         rooms = {room_of[s] for s in members if s in room_of}
-        if any(o.name not in own and o.category in categories and (not rooms or room_types.get(o.room or "") in rooms)
-               and (o.movable or not is_moved) for o in world.objects.values()):
+        if any(
+            o.name not in own
+            and o.category in categories
+            and (not rooms or room_types.get(o.room or "") in rooms)
+            and (o.movable or not is_moved)
+            for o in world.objects.values()
+        ):
             out.update(unnamed)
     return sorted(out)
 
@@ -115,7 +127,9 @@ def scope_groups(goal: list[ParsedLiteral], objects: Mapping[str, list[str]]) ->
     for s in written:
         if s in seen:
             continue
-        twins = tuple(t for t in written if t not in seen and scope_synset(t) == scope_synset(s) and _exchangeable(goal, s, t))
+        twins = tuple(
+            t for t in written if t not in seen and scope_synset(t) == scope_synset(s) and _exchangeable(goal, s, t)
+        )
         seen.update(twins)
         groups.append(ScopeGroup(twins, None))
     return groups
@@ -150,4 +164,3 @@ def _exchangeable(goal: list[ParsedLiteral], a: str, b: str) -> bool:
         return swap.get(node, node) if isinstance(node, str) else [swapped(x) for x in node]
 
     return sorted(literal_text(c) for c in goal) == sorted(literal_text(swapped(c)) for c in goal)
-

@@ -83,7 +83,9 @@ class Camera:
         return np.stack([x, y, np.ones_like(x)], axis=1)
 
 
-def camera_pose(x: float, y: float, yaw: float, *, height_m: float = HEAD_HEIGHT_M, pitch_rad: float = math.radians(PITCH_DEG)) -> np.ndarray:
+def camera_pose(
+    x: float, y: float, yaw: float, *, height_m: float = HEAD_HEIGHT_M, pitch_rad: float = math.radians(PITCH_DEG)
+) -> np.ndarray:
     """T_world_cam of a camera at (x, y, height_m) facing ``yaw`` and pitched ``pitch_rad`` down.
 
     The columns of the rotation are the camera's x (right), y (down) and z (forward) axes in the

@@ -52,11 +52,27 @@ MAX_SUPPORT_TOP_M = 2.0
 MIN_SUPPORT_TOP_M = 0.25
 """Furniture lower than this (mats, low platforms) is not used as a surface."""
 
-SURFACE_SYNSETS: frozenset[str] = frozenset({
-    "table.n.02", "carrel.n.02", "work_surface.n.01", "shelf.n.01", "bookcase.n.01", "grocery_shelf.n.01",
-    "snack_rack.n.01", "cabinet.n.01", "bed.n.01", "hospital_bed.n.02", "sofa.n.01", "bench.n.01",
-    "handcart.n.01", "free_weight_rack.n.01", "sink.n.01", "stove.n.01", "grill.n.02",
-})
+SURFACE_SYNSETS: frozenset[str] = frozenset(
+    {
+        "table.n.02",
+        "carrel.n.02",
+        "work_surface.n.01",
+        "shelf.n.01",
+        "bookcase.n.01",
+        "grocery_shelf.n.01",
+        "snack_rack.n.01",
+        "cabinet.n.01",
+        "bed.n.01",
+        "hospital_bed.n.02",
+        "sofa.n.01",
+        "bench.n.01",
+        "handcart.n.01",
+        "free_weight_rack.n.01",
+        "sink.n.01",
+        "stove.n.01",
+        "grill.n.02",
+    }
+)
 """Furniture whose top things are put on, by bddl synset and its descendants: tables and desks
 (counters and office cubicles included), worktops, shelves, bookcases, cabinets, beds, sofas and
 benches, carts, weight racks, sinks (basin and rim) and cooktops (stoves, grills). Not monitors,
@@ -139,8 +155,11 @@ def _descends_from(category: str, synsets: frozenset[str]) -> bool:
 
 
 def _is_loose(category: str) -> bool:
-    return (category not in catalog.SKIPPED_CATEGORIES and category not in FIXTURE_CATEGORIES
-            and catalog.furniture_role(category) == "skip")
+    return (
+        category not in catalog.SKIPPED_CATEGORIES
+        and category not in FIXTURE_CATEGORIES
+        and catalog.furniture_role(category) == "skip"
+    )
 
 
 def add_distractors(world: World, rng: np.random.Generator, counts: dict[str, dict[str, int]] | None = None) -> Clutter:
@@ -164,10 +183,19 @@ def add_distractors(world: World, rng: np.random.Generator, counts: dict[str, di
                 while f"{category}_o{serial}" in world.objects:
                     serial += 1
                 name = f"{category}_o{serial}"
-                world.add(WorldObject(
-                    name=name, category=category, kind="item", room=room, synset=synset,
-                    center=np.zeros(3), size=np.array(size, dtype=float), openable=openable, cloth=cloth,
-                ))
+                world.add(
+                    WorldObject(
+                        name=name,
+                        category=category,
+                        kind="item",
+                        room=room,
+                        synset=synset,
+                        center=np.zeros(3),
+                        size=np.array(size, dtype=float),
+                        openable=openable,
+                        cloth=cloth,
+                    )
+                )
                 if placer.place(name):
                     clutter.items.append(name)
                 else:
@@ -203,7 +231,9 @@ class _RoomPlacer:
 
     def _on_support(self, obj: WorldObject) -> bool:
         if obj.category not in self._fitting:  # one category, one size
-            self._fitting[obj.category] = [i for i, (s, rel) in enumerate(self.supports) if _fits(self.world, obj, s, rel)]
+            self._fitting[obj.category] = [
+                i for i, (s, rel) in enumerate(self.supports) if _fits(self.world, obj, s, rel)
+            ]
         fits = [i for i in self._fitting[obj.category] if (i, obj.category) not in self.full]
         if not fits:
             return False

@@ -47,7 +47,9 @@ def description_additions() -> dict[str, str]:
     return dict(data["additions"])
 
 
-def description_template(definition: TaskDefinition, world: World, scope: Mapping[str, str], mode: str = "named") -> str:
+def description_template(
+    definition: TaskDefinition, world: World, scope: Mapping[str, str], mode: str = "named"
+) -> str:
     """The description of a task instance with ``$scope`` words (module docstring); ``scope`` maps
     scope names to world object names."""
     check_description_mode(mode)

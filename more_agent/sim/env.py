@@ -81,7 +81,13 @@ _COORD_LIMIT_M = 1e4
 def make_action(kind: str, target: str = "", amount: float | None = None) -> dict[str, Any]:
     """An action dict for ``kind`` (a name in ACTION_TYPES); the amount defaults to a full step or turn."""
     if amount is None:
-        amount = actions.FORWARD_STEP_M if kind == "move_forward" else actions.MAX_TURN_RAD if kind.startswith("turn") else 0.0
+        amount = (
+            actions.FORWARD_STEP_M
+            if kind == "move_forward"
+            else actions.MAX_TURN_RAD
+            if kind.startswith("turn")
+            else 0.0
+        )
     return {"type": ACTION_TYPES.index(kind), "amount": np.array(amount, dtype=np.float32), "target": target}
 
 
@@ -89,8 +95,14 @@ def frame_from_observation(obs: Mapping[str, np.ndarray]) -> Frame:
     """The renderer's ``Frame`` (NaN for invalid depth) from an observation."""
     depth = obs["depth"].astype(np.float32, copy=True)
     depth[depth <= 0] = np.nan
-    return Frame(rgb=obs["rgb"].copy(), depth=depth, semantic=obs["semantic"].copy(), instance=obs["instance"].copy(),
-                 K=obs["intrinsics"].copy(), T_world_cam=obs["pose"].copy())
+    return Frame(
+        rgb=obs["rgb"].copy(),
+        depth=depth,
+        semantic=obs["semantic"].copy(),
+        instance=obs["instance"].copy(),
+        K=obs["intrinsics"].copy(),
+        T_world_cam=obs["pose"].copy(),
+    )
 
 
 class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
@@ -98,9 +110,18 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
 
-    def __init__(self, task: str | None = None, scene: str | None = None, *, render_mode: str | None = None,
-                 max_steps: int | None = 1000, camera: Camera | None = None, path_frame_spacing_m: float = 1.0,
-                 sensors: bool = True, privileged_info: bool = False) -> None:
+    def __init__(
+        self,
+        task: str | None = None,
+        scene: str | None = None,
+        *,
+        render_mode: str | None = None,
+        max_steps: int | None = 1000,
+        camera: Camera | None = None,
+        path_frame_spacing_m: float = 1.0,
+        sensors: bool = True,
+        privileged_info: bool = False,
+    ) -> None:
         """``task`` / ``scene``: what reset loads when its options name nothing; ``max_steps``: truncation
         limit in env steps (None: none); ``path_frame_spacing_m``: spacing of the views along a
         navigation path (0: none); ``sensors``: render observations; ``privileged_info``: add the goal
@@ -116,24 +137,34 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         hw = (cam.height, cam.width)
         ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
         state: dict[str, spaces.Space[Any]] = {
-            "robot_pose": spaces.Box(np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
-                                     np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]), (3,), np.float64),
+            "robot_pose": spaces.Box(
+                np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
+                np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]),
+                (3,),
+                np.float64,
+            ),
             "held": spaces.Box(0, _INT32_MAX, (), np.int32),
         }
-        self.observation_space = spaces.Dict(state if not sensors else {  # type: ignore[assignment]  # a Dict space
-            "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
-            "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
-            "semantic": ids,
-            "instance": ids,
-            "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
-            "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
-            **state,
-        })
-        self.action_space = spaces.Dict({
-            "type": spaces.Discrete(len(ACTION_TYPES)),
-            "amount": spaces.Box(0.0, np.float32(math.pi), (), np.float32),
-            "target": spaces.Text(max_length=128, min_length=0, charset=TARGET_CHARSET),
-        })
+        self.observation_space = spaces.Dict(
+            state
+            if not sensors
+            else {  # type: ignore[assignment]  # a Dict space
+                "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
+                "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
+                "semantic": ids,
+                "instance": ids,
+                "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
+                "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
+                **state,
+            }
+        )
+        self.action_space = spaces.Dict(
+            {
+                "type": spaces.Discrete(len(ACTION_TYPES)),
+                "amount": spaces.Box(0.0, np.float32(math.pi), (), np.float32),
+                "target": spaces.Text(max_length=128, min_length=0, charset=TARGET_CHARSET),
+            }
+        )
         self.world: World | None = None
         self.instance: TaskInstance | None = None
         self._goal: GoalChecker | None = None
@@ -143,7 +174,9 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         self._last_rgb: np.ndarray | None = None
 
     # -- episode ---------------------------------------------------------------------------------
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
         options = options or {}
         world = options.get("world")
@@ -166,13 +199,17 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         feedback = "turned around in place" if self.sensors else "ready"
         info = self._info(status, "reset", True, None, feedback, self._low_level_steps, [], turn_frames[0]["instances"])
         info.update(
-            turn_frames=turn_frames if self.sensors else [], path_frames=[], class_names=list(self.world.class_names),
+            turn_frames=turn_frames if self.sensors else [],
+            path_frames=[],
+            class_names=list(self.world.class_names),
             task=self.instance.task if self.instance else None,
             task_description=self.instance.description if self.instance else None,
         )
         return obs, info
 
-    def step(self, action: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], SupportsFloat, bool, bool, dict[str, Any]]:
+    def step(
+        self, action: Mapping[str, Any]
+    ) -> tuple[dict[str, np.ndarray], SupportsFloat, bool, bool, dict[str, Any]]:
         if self.world is None:
             raise RuntimeError("call reset() before step()")
         self._steps += 1
@@ -185,15 +222,29 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             ok, reason, feedback, steps = True, None, "episode ended", 0
         elif kind in MOTIONS:
             res = self._move(kind, amount)
-            ok, reason, feedback, steps = res.ok, res.reason.value if res.reason else None, res.feedback, res.low_level_steps
+            ok, reason, feedback, steps = (
+                res.ok,
+                res.reason.value if res.reason else None,
+                res.feedback,
+                res.low_level_steps,
+            )
         else:
             name = self.resolve(target)
             if name is None:
                 ok, reason, feedback, steps = False, "unknown_object", f"unknown object {target!r}", 0
             else:
                 assert kind is not None  # parsed without error
-                act = actions.navigate_to(self.world, name) if kind == "navigate_to" else actions.go_to_and(self.world, kind, name)
-                ok, reason, feedback, steps = act.ok, act.reason.value if act.reason else None, act.feedback, act.low_level_steps
+                act = (
+                    actions.navigate_to(self.world, name)
+                    if kind == "navigate_to"
+                    else actions.go_to_and(self.world, kind, name)
+                )
+                ok, reason, feedback, steps = (
+                    act.ok,
+                    act.reason.value if act.reason else None,
+                    act.feedback,
+                    act.low_level_steps,
+                )
                 path, blocking = list(act.path), act.blocking
         self._low_level_steps += steps
         record = self._record()
@@ -214,7 +265,8 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         if key in self.world.objects:
             return key
         obj = self.world.by_label(key) or next(
-            (o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None)
+            (o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None
+        )
         return obj.name if obj is not None else None
 
     def render(self) -> np.ndarray | None:
@@ -265,7 +317,9 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         if kind == "move_forward":
             return motion.move_forward(self.world, amount)
         if amount < 0:
-            return motion.MotionResult(False, motion.MotionFailure.INVALID_AMOUNT, f"turn amount must be >= 0, got {amount}", 0.0)
+            return motion.MotionResult(
+                False, motion.MotionFailure.INVALID_AMOUNT, f"turn amount must be >= 0, got {amount}", 0.0
+            )
         return motion.turn(self.world, amount if kind == "turn_left" else -amount)
 
     def _status(self) -> GoalStatus | None:
@@ -283,8 +337,13 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             return {"obs": state, "instances": {}}
         frame = self.renderer.render_at(self.world, self.renderer.camera.pose(x, y, yaw))
         obs = {
-            "rgb": frame.rgb, "depth": np.nan_to_num(frame.depth, nan=0.0), "semantic": frame.semantic,
-            "instance": frame.instance, "pose": frame.T_world_cam, "intrinsics": frame.K, **state,
+            "rgb": frame.rgb,
+            "depth": np.nan_to_num(frame.depth, nan=0.0),
+            "semantic": frame.semantic,
+            "instance": frame.instance,
+            "pose": frame.T_world_cam,
+            "intrinsics": frame.K,
+            **state,
         }
         return {"obs": obs, "instances": instance_table(self.world, frame.instance)}
 
@@ -300,12 +359,27 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
                 out.append(self._record((x0 + (x1 - x0) * s / length, y0 + (y1 - y0) * s / length, heading)))
         return out
 
-    def _info(self, status: GoalStatus | None, kind: str, ok: bool, reason: str | None, feedback: str, steps: int,
-              path: list[tuple[float, float]], instances: dict[int, dict[str, Any]]) -> dict[str, Any]:
+    def _info(
+        self,
+        status: GoalStatus | None,
+        kind: str,
+        ok: bool,
+        reason: str | None,
+        feedback: str,
+        steps: int,
+        path: list[tuple[float, float]],
+        instances: dict[int, dict[str, Any]],
+    ) -> dict[str, Any]:
         info = {
-            "action": kind, "action_ok": ok, "reason": reason, "feedback": feedback,
-            "low_level_steps": steps, "total_low_level_steps": self._low_level_steps, "steps": self._steps,
-            "path": [tuple(map(float, p)) for p in path], "instances": instances,
+            "action": kind,
+            "action_ok": ok,
+            "reason": reason,
+            "feedback": feedback,
+            "low_level_steps": steps,
+            "total_low_level_steps": self._low_level_steps,
+            "steps": self._steps,
+            "path": [tuple(map(float, p)) for p in path],
+            "instances": instances,
         }
         if self.privileged_info:
             info["goal_status"] = status

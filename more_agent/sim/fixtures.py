@@ -23,10 +23,24 @@ from more_agent.sim.scene import Wall
 from more_agent.sim.world import World, WorldObject
 
 WALL_FIXTURE_HEIGHTS_M: dict[str, float] = {
-    "wall_nail": 1.5, "hook": 1.5, "towel_rack": 1.0, "mirror": 1.0, "wall_mounted_tv": 1.2,
-    "whiteboard": 0.9, "blackboard": 0.9, "showerhead": 1.0, "electric_switch": 1.1, "wall_socket": 0.3,
-    "picture": 1.3, "painting": 1.3, "portrait": 1.3, "wall_clock": 1.8, "paper_towel_dispenser": 1.2,
-    "soap_dispenser": 1.0, "toilet_paper_holder": 0.6, "hand_dryer": 1.1,
+    "wall_nail": 1.5,
+    "hook": 1.5,
+    "towel_rack": 1.0,
+    "mirror": 1.0,
+    "wall_mounted_tv": 1.2,
+    "whiteboard": 0.9,
+    "blackboard": 0.9,
+    "showerhead": 1.0,
+    "electric_switch": 1.1,
+    "wall_socket": 0.3,
+    "picture": 1.3,
+    "painting": 1.3,
+    "portrait": 1.3,
+    "wall_clock": 1.8,
+    "paper_towel_dispenser": 1.2,
+    "soap_dispenser": 1.0,
+    "toilet_paper_holder": 0.6,
+    "hand_dryer": 1.1,
 }
 """Categories hung on a wall that the generator leaves out, with the height (m) of their bottom face
 (lowered where the wall is not that high)."""
@@ -73,9 +87,17 @@ def hang_listed_fixtures(world: World, room: str, categories: set[str]) -> list[
         while f"{category}_{k}" in world.objects:
             k += 1
         center, extent = box
-        world.add(WorldObject(name=f"{category}_{k}", category=category, kind="furniture", room=room,
-                              synset=next(iter(catalog.category_synsets(category)), None),
-                              center=center, size=extent))
+        world.add(
+            WorldObject(
+                name=f"{category}_{k}",
+                category=category,
+                kind="furniture",
+                room=room,
+                synset=next(iter(catalog.category_synsets(category)), None),
+                center=center,
+                size=extent,
+            )
+        )
         added.append(f"{category}_{k}")
     return added
 
@@ -96,8 +118,9 @@ def _room_walls(world: World, room: str) -> list[tuple[Wall, str]]:
     return out
 
 
-def _wall_spot(world: World, room: str, size: np.ndarray, height: float,
-               rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray] | None:
+def _wall_spot(
+    world: World, room: str, size: np.ndarray, height: float, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray] | None:
     """(centre, size) of a box against one of the room's walls, its long side along the wall, its
     bottom at ``height`` (lower when the wall is low), meeting no other object's box; None if none."""
     rx0, ry0, rx1, ry1 = world.scene.room(room).bounds

@@ -24,16 +24,45 @@ from more_agent.vocabulary import OUTDOOR_ROOM_TYPES, room_type
 Rect = tuple[float, float, float, float]
 
 TYPICAL_AREA_M2: dict[str, tuple[float, float]] = {
-    "kitchen": (12, 20), "bathroom": (5, 8), "bedroom": (12, 16), "childs_room": (10, 14),
-    "living_room": (20, 35), "dining_room": (14, 22), "television_room": (14, 22), "corridor": (6, 12),
-    "entryway": (5, 9), "closet": (2.5, 5), "pantry_room": (3, 6), "storage_room": (6, 12),
-    "utility_room": (6, 10), "garage": (30, 42), "garden": (60, 150), "staircase": (6, 10),
-    "private_office": (10, 16), "shared_office": (25, 45), "meeting_room": (16, 30), "copy_room": (6, 10),
-    "phone_room": (3, 5), "break_room": (12, 20), "conference_hall": (80, 150), "lobby": (40, 80),
-    "grocery_store": (150, 300), "classroom": (50, 70), "biology_lab": (50, 70), "chemistry_lab": (50, 70),
-    "computer_lab": (50, 70), "infirmary": (20, 30), "gym": (80, 150), "bar": (30, 60), "spa": (20, 40),
-    "sauna": (6, 10), "hammam": (20, 35), "locker_room": (20, 35), "exercise_room": (20, 35),
-    "playroom": (12, 20), "empty_room": (10, 20),
+    "kitchen": (12, 20),
+    "bathroom": (5, 8),
+    "bedroom": (12, 16),
+    "childs_room": (10, 14),
+    "living_room": (20, 35),
+    "dining_room": (14, 22),
+    "television_room": (14, 22),
+    "corridor": (6, 12),
+    "entryway": (5, 9),
+    "closet": (2.5, 5),
+    "pantry_room": (3, 6),
+    "storage_room": (6, 12),
+    "utility_room": (6, 10),
+    "garage": (30, 42),
+    "garden": (60, 150),
+    "staircase": (6, 10),
+    "private_office": (10, 16),
+    "shared_office": (25, 45),
+    "meeting_room": (16, 30),
+    "copy_room": (6, 10),
+    "phone_room": (3, 5),
+    "break_room": (12, 20),
+    "conference_hall": (80, 150),
+    "lobby": (40, 80),
+    "grocery_store": (150, 300),
+    "classroom": (50, 70),
+    "biology_lab": (50, 70),
+    "chemistry_lab": (50, 70),
+    "computer_lab": (50, 70),
+    "infirmary": (20, 30),
+    "gym": (80, 150),
+    "bar": (30, 60),
+    "spa": (20, 40),
+    "sauna": (6, 10),
+    "hammam": (20, 35),
+    "locker_room": (20, 35),
+    "exercise_room": (20, 35),
+    "playroom": (12, 20),
+    "empty_room": (10, 20),
 }
 """Plausible (min, max) floor area per BEHAVIOR room type; others get (10, 20)."""
 
@@ -109,8 +138,15 @@ def generate_floorplan(
 
     ``seed`` is only recorded in the scene; all randomness comes from ``rng``. Knobs are in metres.
     """
-    k = dict(t=wall_thickness_m, walk=walkway_m, door_w=door_width_m, door_clear=door_clear_m,
-             r=robot_radius_m, reach=reach_m, res=resolution_m)
+    k = dict(
+        t=wall_thickness_m,
+        walk=walkway_m,
+        door_w=door_width_m,
+        door_clear=door_clear_m,
+        r=robot_radius_m,
+        reach=reach_m,
+        res=resolution_m,
+    )
     items = {room: _room_items(objs) for room, objs in rooms.items()}
     growth = dict.fromkeys(rooms, 1.0)
     for _ in range(max_attempts):
@@ -131,12 +167,25 @@ def generate_floorplan(
         ally = [v for r in rects.values() for v in (r[1], r[3])]
         pad = wall_thickness_m
         return Scene(
-            name=name, seed=seed, wall_height=wall_height_m,
+            name=name,
+            seed=seed,
+            wall_height=wall_height_m,
             bounds=_round((min(allx) - pad, min(ally) - pad, max(allx) + pad, max(ally) + pad)),
-            rooms=[Room(id=rid, type=room_type(rid), bounds=rects[rid],
-                        ground="lawn" if room_type(rid) in OUTDOOR_ROOM_TYPES else "floor",
-                        outdoor=room_type(rid) in OUTDOOR_ROOM_TYPES) for rid in rooms],
-            walls=walls, doors=doors, windows=windows, furniture=furniture, ground_patches=patches,
+            rooms=[
+                Room(
+                    id=rid,
+                    type=room_type(rid),
+                    bounds=rects[rid],
+                    ground="lawn" if room_type(rid) in OUTDOOR_ROOM_TYPES else "floor",
+                    outdoor=room_type(rid) in OUTDOOR_ROOM_TYPES,
+                )
+                for rid in rooms
+            ],
+            walls=walls,
+            doors=doors,
+            windows=windows,
+            furniture=furniture,
+            ground_patches=patches,
         )
     raise RuntimeError(f"could not lay out scene {name!r} in {max_attempts} attempts")
 
@@ -256,8 +305,17 @@ def _layout(rooms, items, rng, clearance, growth: dict[str, float], k) -> dict[s
             length = areas[rid] ** 0.5
         depth = max(areas[rid] / length, 7.0)
         o = offset[side]
-        rects[rid] = _rect(_round({"S": (0, -o - depth, length, -o), "N": (0, h + o, length, h + o + depth),
-                             "W": (-o - depth, 0, -o, length), "E": (w + o, 0, w + o + depth, length)}[side], 2))
+        rects[rid] = _rect(
+            _round(
+                {
+                    "S": (0, -o - depth, length, -o),
+                    "N": (0, h + o, length, h + o + depth),
+                    "W": (-o - depth, 0, -o, length),
+                    "E": (w + o, 0, w + o + depth, length),
+                }[side],
+                2,
+            )
+        )
         offset[side] = o + depth
     return rects
 
@@ -314,9 +372,18 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k) -> list[Door] | 
         slack = max(run.hi - run.lo - 2 * _END_MARGIN_M - k["door_w"], 0.0)
         c = run.lo + _END_MARGIN_M + k["door_w"] / 2 + float(rng.random()) * slack
         center = (c, run.coord) if run.axis == "x" else (run.coord, c)
-        doors.append(Door(id=f"door_{len(doors)}", rooms=(run.neg, run.pos), center=_round(center),
-                          width=k["door_w"], axis=run.axis, thickness=k["t"], height=DOOR_HEIGHT_M,
-                          open=bool(rng.random() >= closed_fraction)))
+        doors.append(
+            Door(
+                id=f"door_{len(doors)}",
+                rooms=(run.neg, run.pos),
+                center=_round(center),
+                width=k["door_w"],
+                axis=run.axis,
+                thickness=k["t"],
+                height=DOOR_HEIGHT_M,
+                open=bool(rng.random() >= closed_fraction),
+            )
+        )
     return doors
 
 
@@ -345,8 +412,15 @@ def _place_windows(runs, doors, rng, k) -> list[Window]:
             continue
         b = (c - width / 2, run.coord - k["t"] / 2, c + width / 2, run.coord + k["t"] / 2)
         bounds = b if run.axis == "x" else (b[1], b[0], b[3], b[2])
-        out.append(Window(id=f"window_{len(out)}", bounds=_round(bounds), sill=WINDOW_SILL_M,
-                          top=WINDOW_TOP_M, rooms=tuple(indoor + [r for r in sides if r not in indoor])))
+        out.append(
+            Window(
+                id=f"window_{len(out)}",
+                bounds=_round(bounds),
+                sill=WINDOW_SILL_M,
+                top=WINDOW_TOP_M,
+                rooms=tuple(indoor + [r for r in sides if r not in indoor]),
+            )
+        )
     return out
 
 
@@ -428,9 +502,18 @@ def _furnish_all(rects, items, doors, windows, rng, k) -> tuple[list[Furniture],
             counters[it.category] = n + 1
             openable = catalog.is_openable(it.category)
             synsets = catalog.category_synsets(it.category)
-            furniture.append(Furniture(
-                id=f"{it.category}_{n}", category=it.category, synset=synsets[0] if synsets else None,
-                model=it.model, room=rid, center=_round(center), size=_round(size), openable=openable))
+            furniture.append(
+                Furniture(
+                    id=f"{it.category}_{n}",
+                    category=it.category,
+                    synset=synsets[0] if synsets else None,
+                    model=it.model,
+                    room=rid,
+                    center=_round(center),
+                    size=_round(size),
+                    openable=openable,
+                )
+            )
     return furniture, patches
 
 

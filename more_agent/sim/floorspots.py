@@ -20,8 +20,13 @@ RASTER_STEP_M = 0.05
 
 
 def free_floor_spot(
-    world: World, room_id: str | None, half: np.ndarray, rng: np.random.Generator,
-    near: WorldObject | None = None, exclude: str | None = None, bounds: tuple[float, float, float, float] | None = None,
+    world: World,
+    room_id: str | None,
+    half: np.ndarray,
+    rng: np.random.Generator,
+    near: WorldObject | None = None,
+    exclude: str | None = None,
+    bounds: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float] | None:
     """A random (x, y) in a room (or in ``bounds``) where a box of half extents ``half`` overlaps no
     furniture, wall, door opening or floor item; with ``near``, close beside that object's box."""

@@ -51,7 +51,10 @@ class _Obstacles:
         codes = self.sides[: self.n]
         gap = np.where((codes == code) | (codes == -2), _GAP_M, walk)
         hit = (
-            (rect[0] < b[:, 2] + gap) & (rect[2] > b[:, 0] - gap) & (rect[1] < b[:, 3] + gap) & (rect[3] > b[:, 1] - gap)
+            (rect[0] < b[:, 2] + gap)
+            & (rect[2] > b[:, 0] - gap)
+            & (rect[1] < b[:, 3] + gap)
+            & (rect[3] > b[:, 1] - gap)
         )
         return not hit.any()
 
@@ -279,9 +282,7 @@ def _reachable(inner, placed, keepouts, k) -> bool:
     if not common:
         return False
     reach = labels == min(common)
-    return all(
-        within_reach(xs, ys, reach, _footprint(c, s), k["reach"]) for it, c, s in placed if it.role != "carpet"
-    )
+    return all(within_reach(xs, ys, reach, _footprint(c, s), k["reach"]) for it, c, s in placed if it.role != "carpet")
 
 
 def within_reach(xs: np.ndarray, ys: np.ndarray, mask: np.ndarray, b: Rect, reach_m: float) -> bool:

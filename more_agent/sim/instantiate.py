@@ -128,7 +128,12 @@ class TaskInstance:
 
 
 def instantiate(
-    task: str, scene: str | None = None, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    task: str,
+    scene: str | None = None,
+    seed: int = 0,
+    *,
+    start: str = "random",
+    distractors: bool = True,
     descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate ``task`` with ``seed`` in a scene generated with that seed.
@@ -159,8 +164,9 @@ def instantiate(
         scene_obj = get_scene(name, seed)
         t_scene = time.perf_counter() - t1
         try:
-            instance = instantiate_in_scene(definition, scene_obj, seed, start=start, distractors=distractors,
-                                            descriptions=descriptions)
+            instance = instantiate_in_scene(
+                definition, scene_obj, seed, start=start, distractors=distractors, descriptions=descriptions
+            )
         except InstantiationError as e:
             if scene is not None:
                 raise InstantiationError(f"{e} (scene {name}, seed {seed}); choose another --seed or --scene") from None
@@ -175,7 +181,12 @@ def instantiate(
 
 
 def instantiate_in_scene(
-    definition: TaskDefinition | str, scene: Scene, seed: int = 0, *, start: str = "random", distractors: bool = True,
+    definition: TaskDefinition | str,
+    scene: Scene,
+    seed: int = 0,
+    *,
+    start: str = "random",
+    distractors: bool = True,
     descriptions: str = "named",
 ) -> TaskInstance:
     """Instantiate a task in a given ``Scene`` object (hand-built scenes included)."""
@@ -199,10 +210,20 @@ def instantiate_in_scene(
         builder.place_robot_at_random(targets, start_rng, by_room=start == "random")
     t_place = time.perf_counter() - t0 - t_bind - t_clutter
     instance = TaskInstance(
-        task=definition.name, scene=scene.name, seed=seed, world=world, description="",
-        scope=builder.scope, virtual_scopes=sorted(builder.virtual), unsupported_literals=builder.unsupported,
-        timings={}, definition=definition, start_mode=start, distractors=clutter.items,
-        start=start_facts(world, targets), descriptions=descriptions,
+        task=definition.name,
+        scene=scene.name,
+        seed=seed,
+        world=world,
+        description="",
+        scope=builder.scope,
+        virtual_scopes=sorted(builder.virtual),
+        unsupported_literals=builder.unsupported,
+        timings={},
+        definition=definition,
+        start_mode=start,
+        distractors=clutter.items,
+        start=start_facts(world, targets),
+        descriptions=descriptions,
     )
     _verify_init(instance)
     instance.description = task_description(instance)
@@ -217,7 +238,8 @@ def task_description(instance: TaskInstance) -> str:
     the scene text agree; every other instance is labelled when first observed.
     """
     instance.description_template = description_template(
-        instance.definition, instance.world, instance.scope, instance.descriptions)
+        instance.definition, instance.world, instance.scope, instance.descriptions
+    )
     return SCOPE_WORD.sub(lambda m: _scope_phrase(instance, m.group(1)), instance.description_template)
 
 
@@ -296,7 +318,8 @@ class _Builder:
         """Largest one-to-one assignment of scopes to this room's furniture / doors of matching category."""
         door_rooms = {d.id: d.rooms for d in self.world.scene.doors}
         candidates = [
-            obj for obj in self.world.objects.values()
+            obj
+            for obj in self.world.objects.values()
             if obj.kind in ("furniture", "door") and (obj.room == room_id or room_id in door_rooms.get(obj.name, ()))
         ]
         cats = {s: set(catalog.synset_categories(scope_synset(s))) for s in scopes}
@@ -318,11 +341,18 @@ class _Builder:
             category = lemma if lemma in cats else str(self.rng.choice(cats))
             name = _item_name(s, taken)
             taken.add(name)
-            self.world.add(WorldObject(
-                name=name, category=category, kind="item", synset=synset,
-                center=np.zeros(3), size=np.array(catalog.category_size(category), dtype=float),
-                openable=catalog.is_openable(category), cloth=catalog.is_cloth(category),
-            ))
+            self.world.add(
+                WorldObject(
+                    name=name,
+                    category=category,
+                    kind="item",
+                    synset=synset,
+                    center=np.zeros(3),
+                    size=np.array(catalog.category_size(category), dtype=float),
+                    openable=catalog.is_openable(category),
+                    cloth=catalog.is_cloth(category),
+                )
+            )
             self.scope[s] = name
             self.items.append(s)
 
@@ -365,7 +395,9 @@ class _Builder:
             negated = lit[0] == "not"
             target = self.world.objects[self.scope[(lit[1] if negated else lit)[1]]]
             if not target.openable:
-                raise InstantiationError(f"{target.name} ({target.category}) cannot be opened or closed", literal_text(lit))
+                raise InstantiationError(
+                    f"{target.name} ({target.category}) cannot be opened or closed", literal_text(lit)
+                )
             self.world.set_open(target.name, not negated)
 
     def _place(self, atom: ParsedLiteral, opened: set[str]) -> None:
@@ -403,8 +435,13 @@ class _Builder:
     def _default_floor(self) -> str:
         return self.agent_floor or floor_name(self.world.scene.rooms[0].id)
 
-    def _on_free_floor(self, name: str, floor: str, near: WorldObject | None = None,
-                       area: tuple[float, float, float, float] | None = None) -> None:
+    def _on_free_floor(
+        self,
+        name: str,
+        floor: str,
+        near: WorldObject | None = None,
+        area: tuple[float, float, float, float] | None = None,
+    ) -> None:
         obj, room = self.world.objects[name], self.world.objects[floor].room
         half = obj.size[:2] / 2 + FLOOR_MARGIN_M
         xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area)
@@ -479,7 +516,8 @@ def _verify_init(instance: TaskInstance) -> None:
             continue
         if instance.start_mode != "task-room" and lit[0] == "ontop" and instance.scope.get(lit[1]) == ROBOT_NAME:
             continue  # the random start replaces the task's own start room (paper Sec. IV-A)
-        head = compile_state([lit], backend, scope=dict(scope), object_map=instance.definition.objects,
-                             generate_ground_options=False)[0]
+        head = compile_state(
+            [lit], backend, scope=dict(scope), object_map=instance.definition.objects, generate_ground_options=False
+        )[0]
         if not head.evaluate():
             raise InstantiationError(f"it does not hold after placement in {instance.scene}", text)

@@ -67,8 +67,11 @@ def _fixed_obstacles(world: World, config: NavConfig) -> tuple[np.ndarray, list[
         if ref() is world and n_objects == len(world.objects) and cfg == config:
             return fixed, doors
     rows = [w.bounds for w in world.scene.walls if w.z_min < config.obstacle_max_bottom_m]
-    rows += [o.footprint() for o in world.objects.values()
-             if o.kind == "furniture" and o.bottom < config.obstacle_max_bottom_m]
+    rows += [
+        o.footprint()
+        for o in world.objects.values()
+        if o.kind == "furniture" and o.bottom < config.obstacle_max_bottom_m
+    ]
     fixed = np.asarray(rows, dtype=np.float64).reshape(-1, 4)
     doors = [o for o in world.objects.values() if o.kind == "door"]
     _FIXED[:] = [(weakref.ref(world), len(world.objects), config, fixed, doors)]

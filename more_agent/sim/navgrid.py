@@ -151,7 +151,10 @@ def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
     passable = region & ~blocked
     clearance = ndimage.distance_transform_edt(passable) * res
     return NavGrid(
-        origin_xy=grid.origin_xy, resolution_m=res, free=clearance > config.robot_radius_m, closed_doors=closed,
+        origin_xy=grid.origin_xy,
+        resolution_m=res,
+        free=clearance > config.robot_radius_m,
+        closed_doors=closed,
         door_cells=door_cells,
     )
 
@@ -230,12 +233,15 @@ def simplify_polyline(points: np.ndarray, tolerance: float) -> np.ndarray:
         dr, dc = r1 - r0, c1 - c0
         angle = -np.arctan2(dr, dc)
         offset = c0 * np.sin(angle) + r0 * np.cos(angle)
-        inner = points[start + 1:end]
+        inner = points[start + 1 : end]
         dr0, dc0 = inner[:, 0] - r0, inner[:, 1] - c0
         dr1, dc1 = inner[:, 0] - r1, inner[:, 1] - c1
         across = ((dr0 * dr + dc0 * dc) > 0) & ((-dr1 * dr - dc1 * dc) > 0)
-        dist = np.where(across, np.abs(inner[:, 0] * np.cos(angle) + inner[:, 1] * np.sin(angle) - offset),
-                        np.minimum(np.sqrt(dc0 ** 2 + dr0 ** 2), np.sqrt(dc1 ** 2 + dr1 ** 2)))
+        dist = np.where(
+            across,
+            np.abs(inner[:, 0] * np.cos(angle) + inner[:, 1] * np.sin(angle) - offset),
+            np.minimum(np.sqrt(dc0**2 + dr0**2), np.sqrt(dc1**2 + dr1**2)),
+        )
         if np.any(dist > tolerance):
             split = start + int(np.argmax(dist)) + 1
             keep[split] = True

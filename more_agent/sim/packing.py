@@ -54,7 +54,10 @@ def support_surface(support: WorldObject, relation: Relation) -> tuple[np.ndarra
 
 
 def magic_fit(
-    obj: WorldObject, support: WorldObject, relation: Relation, others: Sequence[WorldObject],
+    obj: WorldObject,
+    support: WorldObject,
+    relation: Relation,
+    others: Sequence[WorldObject],
 ) -> tuple[np.ndarray, np.ndarray]:
     """Centre and size where ``obj`` fits, stacking when the surface is full (``fit``), else the
     support's centre: magic placement, like the paper's, never fails for lack of room."""
@@ -67,7 +70,12 @@ def magic_fit(
 
 
 def fit(
-    obj: WorldObject, support: WorldObject, relation: Relation, others: Sequence[WorldObject], *, stack: bool = False,
+    obj: WorldObject,
+    support: WorldObject,
+    relation: Relation,
+    others: Sequence[WorldObject],
+    *,
+    stack: bool = False,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """(centre, size) of ``obj`` at its first free slot (``free_slot``) among ``others`` in its own shape
     or, for cloth, folded in half up to ``MAX_FOLDS`` times, as a garment goes into a washer or a carton;
@@ -88,8 +96,13 @@ def fit(
 
 
 def free_slot(
-    obj: WorldObject, support: WorldObject, relation: Relation, others: Sequence[WorldObject], *,
-    stack: bool = False, size: np.ndarray | None = None,
+    obj: WorldObject,
+    support: WorldObject,
+    relation: Relation,
+    others: Sequence[WorldObject],
+    *,
+    stack: bool = False,
+    size: np.ndarray | None = None,
 ) -> np.ndarray | None:
     """Centre of the first slot on the support, in reading order, where the item's box (of ``size``,
     default its own) meets none of ``others`` standing in the space it would take (``in_space``); with

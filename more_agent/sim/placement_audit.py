@@ -26,7 +26,9 @@ def enclosing_object(world: World, name: str) -> str | None:
     if not others:
         return None
     centers, halves = np.array([o.center for o in others]), np.array([o.size for o in others]) / 2
-    encloses = np.all(lo >= centers - halves - TOLERANCE_M, axis=1) & np.all(hi <= centers + halves + TOLERANCE_M, axis=1)
+    encloses = np.all(lo >= centers - halves - TOLERANCE_M, axis=1) & np.all(
+        hi <= centers + halves + TOLERANCE_M, axis=1
+    )
     return next((o.name for o, e in zip(others, encloses) if e), None)
 
 

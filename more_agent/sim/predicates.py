@@ -36,6 +36,7 @@ TOUCH_GAP_M = 0.02
 ROBOT_NAME = "robot"
 """World name the agent scope (``agent.n.01_1``) stands for."""
 
+
 def is_open(world: World, name: str) -> bool:
     """``open(a)``: an openable object that is open."""
     obj = world.objects.get(name)
@@ -104,8 +105,13 @@ def is_grasped(world: World, agent: str, name: str) -> bool:
 
 
 PREDICATES: dict[str, Callable[..., bool]] = {
-    "inside": is_inside, "ontop": is_ontop, "open": is_open, "nextto": is_nextto,
-    "under": is_under, "touching": is_touching, "grasped": is_grasped,
+    "inside": is_inside,
+    "ontop": is_ontop,
+    "open": is_open,
+    "nextto": is_nextto,
+    "under": is_under,
+    "touching": is_touching,
+    "grasped": is_grasped,
 }
 """The predicates the world models, by bddl name."""
 

@@ -52,8 +52,14 @@ PATCH_TOP_M = 0.001
 """Top of a ground patch (carpet, driveway) slab: just above the room floor so that it shows."""
 
 _STRUCTURAL_COLORS: dict[str, tuple[int, int, int]] = {
-    "unlabeled": (0, 0, 0), "floor": (196, 170, 130), "carpet": (150, 70, 80), "lawn": (90, 160, 70),
-    "driveway": (120, 120, 120), "wall": (225, 225, 215), "door": (140, 90, 50), "window": (150, 200, 230),
+    "unlabeled": (0, 0, 0),
+    "floor": (196, 170, 130),
+    "carpet": (150, 70, 80),
+    "lawn": (90, 160, 70),
+    "driveway": (120, 120, 120),
+    "wall": (225, 225, 215),
+    "door": (140, 90, 50),
+    "window": (150, 200, 230),
 }
 
 
@@ -108,7 +114,8 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
         x0, y0, x1, y1 = patch.bounds
         boxes.append((np.array([x0, y0, -0.01]), np.array([x1, y1, PATCH_TOP_M]), world.semantic_id(patch.ground), 0))
     holds_inside = {  # in it, or on one of its inner levels (world.LEVELLED_CATEGORIES)
-        o.parent for o in world.objects.values()
+        o.parent
+        for o in world.objects.values()
         if o.parent is not None and (o.relation == "inside" or o.bottom < world.objects[o.parent].top - 1e-6)
     }
     for obj in world.objects.values():
@@ -128,10 +135,14 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
     ny = int(np.ceil((max(y1, hi[:, 1].max()) + cell_m - y0) / cell_m))
     start, items = _build_grid(lo, hi, x0, y0, cell_m, nx, ny)
     return SceneGeometry(
-        lo=lo, hi=hi, semantic=np.array([b[2] for b in boxes], dtype=np.int32),
+        lo=lo,
+        hi=hi,
+        semantic=np.array([b[2] for b in boxes], dtype=np.int32),
         instance=np.array([b[3] for b in boxes], dtype=np.int32),
-        grid=Grid(origin_xy=(float(x0), float(y0)), resolution_m=cell_m), shape=(nx, ny),
-        cell_start=start, cell_items=items,
+        grid=Grid(origin_xy=(float(x0), float(y0)), resolution_m=cell_m),
+        shape=(nx, ny),
+        cell_start=start,
+        cell_items=items,
         palette=class_colors(world.class_names).astype(np.float64),
     )
 
@@ -172,7 +183,9 @@ def _cage(lo: np.ndarray, hi: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]
 
 
 @njit(cache=True)
-def _build_grid(lo: np.ndarray, hi: np.ndarray, x0: float, y0: float, cell: float, nx: int, ny: int) -> tuple[np.ndarray, np.ndarray]:
+def _build_grid(
+    lo: np.ndarray, hi: np.ndarray, x0: float, y0: float, cell: float, nx: int, ny: int
+) -> tuple[np.ndarray, np.ndarray]:
     """CSR lists of the boxes overlapping each grid cell (counting pass, then filling pass)."""
     n = lo.shape[0]
     ranges = np.empty((n, 4), dtype=np.int64)
@@ -199,10 +212,28 @@ def _build_grid(lo: np.ndarray, hi: np.ndarray, x0: float, y0: float, cell: floa
 
 
 @njit(cache=True, error_model="numpy")
-def _cast(origin: np.ndarray, rot: np.ndarray, rays: np.ndarray, max_t: float, x0: float, y0: float, cell: float,
-          nx: int, ny: int, start: np.ndarray, items: np.ndarray, lo: np.ndarray, hi: np.ndarray, box_sem: np.ndarray,
-          box_inst: np.ndarray, palette: np.ndarray, depth: np.ndarray, sem: np.ndarray, inst: np.ndarray,
-          rgb: np.ndarray) -> None:
+def _cast(
+    origin: np.ndarray,
+    rot: np.ndarray,
+    rays: np.ndarray,
+    max_t: float,
+    x0: float,
+    y0: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    start: np.ndarray,
+    items: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    box_sem: np.ndarray,
+    box_inst: np.ndarray,
+    palette: np.ndarray,
+    depth: np.ndarray,
+    sem: np.ndarray,
+    inst: np.ndarray,
+    rgb: np.ndarray,
+) -> None:
     """Nearest hit of each ray origin + t * rot @ rays[r], t in [0, max_t]; NaN / 0 / 0 / black on a miss.
 
     Camera-frame rays have z = 1, so t is the z-depth. Each box is tested once per ray (mailbox).
@@ -333,12 +364,36 @@ class Renderer:
         sem = np.empty(n, dtype=np.int32)
         inst = np.empty(n, dtype=np.int32)
         rgb = np.empty((n, 3), dtype=np.uint8)
-        _cast(np.ascontiguousarray(T[:3, 3]), np.ascontiguousarray(T[:3, :3]), self._rays, cam.max_range_m,
-              *g.grid.origin_xy, g.grid.resolution_m, g.shape[0], g.shape[1], g.cell_start, g.cell_items, g.lo, g.hi,
-              g.semantic, g.instance, g.palette, depth, sem, inst, rgb)
+        _cast(
+            np.ascontiguousarray(T[:3, 3]),
+            np.ascontiguousarray(T[:3, :3]),
+            self._rays,
+            cam.max_range_m,
+            *g.grid.origin_xy,
+            g.grid.resolution_m,
+            g.shape[0],
+            g.shape[1],
+            g.cell_start,
+            g.cell_items,
+            g.lo,
+            g.hi,
+            g.semantic,
+            g.instance,
+            g.palette,
+            depth,
+            sem,
+            inst,
+            rgb,
+        )
         hw = (cam.height, cam.width)
-        return Frame(rgb=rgb.reshape(*hw, 3), depth=depth.reshape(hw), semantic=sem.reshape(hw), instance=inst.reshape(hw),
-                     K=self._K.copy(), T_world_cam=T.copy())
+        return Frame(
+            rgb=rgb.reshape(*hw, 3),
+            depth=depth.reshape(hw),
+            semantic=sem.reshape(hw),
+            instance=inst.reshape(hw),
+            K=self._K.copy(),
+            T_world_cam=T.copy(),
+        )
 
 
 def render(world: World, camera: Camera | None = None) -> Frame:
@@ -368,7 +423,12 @@ def instance_table(world: World, instance: np.ndarray) -> dict[int, dict[str, An
         order = {int(i): int(k) for i, k in zip(ids, first)}
         world.observe(by_id[i].name for i in sorted(new, key=lambda i: (order.get(i, -1), i)))
     return {
-        i: {"name": by_id[i].name, "label": by_id[i].label, "category": by_id[i].category,
-            "open": bool(by_id[i].is_open) if by_id[i].openable else None, "held": by_id[i].name == held}
+        i: {
+            "name": by_id[i].name,
+            "label": by_id[i].label,
+            "category": by_id[i].category,
+            "open": bool(by_id[i].is_open) if by_id[i].openable else None,
+            "held": by_id[i].name == held,
+        }
         for i in sorted(seen)
     }

@@ -106,7 +106,9 @@ class Door(_Strict):
     width: float = Field(gt=0.3, le=MAX_COORD_M, description="Clear width of the opening in metres.")
     axis: Literal["x", "y"] = Field(description="World axis along which the opening extends (the wall's direction).")
     thickness: float = Field(default=0.1, gt=0, le=MAX_COORD_M, description="Wall thickness at the door in metres.")
-    height: float = Field(default=2.1, gt=1.0, le=MAX_COORD_M, description="Height of the opening; a lintel sits above it.")
+    height: float = Field(
+        default=2.1, gt=1.0, le=MAX_COORD_M, description="Height of the opening; a lintel sits above it."
+    )
     open: bool = Field(default=True, description="Initial state.")
 
     @model_validator(mode="after")

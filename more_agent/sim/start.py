@@ -53,13 +53,20 @@ def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[
     for t in targets:
         x0, y0, x1, y1 = reach_box(world, t)
         for poses in candidate_poses(world, t):
-            cells += [grid.cell_at(x, y) for x, y in poses
-                      if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)]
+            cells += [
+                grid.cell_at(x, y)
+                for x, y in poses
+                if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)
+            ]
     return cells
 
 
 def random_start(
-    world: World, targets: list[str], rng: np.random.Generator, *, by_room: bool = False,
+    world: World,
+    targets: list[str],
+    rng: np.random.Generator,
+    *,
+    by_room: bool = False,
 ) -> tuple[float, float, float] | None:
     """A uniformly drawn (x, y, yaw) on the free space connected to a pose that reaches a task object
     (anywhere free when there is no target); None if there is none.
@@ -76,8 +83,10 @@ def random_start(
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
         xy = grid.xy_of(np.stack(list(np.indices(grid.shape)), axis=-1))
         x, y = xy[..., 0], xy[..., 1]
-        in_room = [free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
-                   for r in world.scene.rooms]
+        in_room = [
+            free & (x >= r.bounds[0]) & (x <= r.bounds[2]) & (y >= r.bounds[1]) & (y <= r.bounds[3])
+            for r in world.scene.rooms
+        ]
         rooms = [m for m in in_room if m.sum() >= min_cells]
         if rooms:
             free = rooms[rng.integers(len(rooms))]

@@ -246,8 +246,11 @@ def compute_suitable_scenes(task: TaskDefinition) -> list[str]:
 
 
 # -- language descriptions generated from the goal -------------------------------------------------
-_DO = {"inside": ("put {0} inside {1}", "take {0} out of {1}"), "ontop": ("put {0} on top of {1}", "take {0} off {1}"),
-       "open": ("open {0}", "close {0}")}
+_DO = {
+    "inside": ("put {0} inside {1}", "take {0} out of {1}"),
+    "ontop": ("put {0} on top of {1}", "take {0} off {1}"),
+    "open": ("open {0}", "close {0}"),
+}
 _IS = {"inside": "{0} is inside {1}", "ontop": "{0} is on top of {1}", "open": "{0} is open"}
 
 

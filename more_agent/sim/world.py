@@ -67,23 +67,45 @@ class World:
         world = cls(scene=scene)
         for room in scene.rooms:
             x0, y0, x1, y1 = room.bounds
-            world.add(WorldObject(
-                name=floor_name(room.id), category=room.ground, kind="floor", room=room.id,
-                center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, -0.005]), size=np.array([x1 - x0, y1 - y0, 0.01]),
-            ))
+            world.add(
+                WorldObject(
+                    name=floor_name(room.id),
+                    category=room.ground,
+                    kind="floor",
+                    room=room.id,
+                    center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, -0.005]),
+                    size=np.array([x1 - x0, y1 - y0, 0.01]),
+                )
+            )
         for door in scene.doors:
             x0, y0, x1, y1 = door.bounds()
-            world.add(WorldObject(
-                name=door.id, category="door", kind="door", room=door.rooms[0], synset="door.n.01",
-                center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, door.height / 2]),
-                size=np.array([x1 - x0, y1 - y0, door.height]), openable=True, is_open=door.open,
-            ))
+            world.add(
+                WorldObject(
+                    name=door.id,
+                    category="door",
+                    kind="door",
+                    room=door.rooms[0],
+                    synset="door.n.01",
+                    center=np.array([(x0 + x1) / 2, (y0 + y1) / 2, door.height / 2]),
+                    size=np.array([x1 - x0, y1 - y0, door.height]),
+                    openable=True,
+                    is_open=door.open,
+                )
+            )
         for f in scene.furniture:
-            world.add(WorldObject(
-                name=f.id, category=f.category, kind="furniture", room=f.room, synset=f.synset,
-                center=np.array(f.center, dtype=float), size=np.array(f.size, dtype=float),
-                openable=f.openable, is_open=f.open,
-            ))
+            world.add(
+                WorldObject(
+                    name=f.id,
+                    category=f.category,
+                    kind="furniture",
+                    room=f.room,
+                    synset=f.synset,
+                    center=np.array(f.center, dtype=float),
+                    size=np.array(f.size, dtype=float),
+                    openable=f.openable,
+                    is_open=f.open,
+                )
+            )
         return world
 
     def add(self, obj: WorldObject) -> WorldObject:
@@ -228,7 +250,9 @@ class World:
         obj, support = self.objects[name], self.objects[floor]
         self._rest(obj, support, "ontop", np.array([xy[0], xy[1], support.top + obj.size[2] / 2]), obj.size)
 
-    def _rest(self, obj: WorldObject, support: WorldObject, relation: Relation, center: np.ndarray, size: np.ndarray) -> None:
+    def _rest(
+        self, obj: WorldObject, support: WorldObject, relation: Relation, center: np.ndarray, size: np.ndarray
+    ) -> None:
         """Make ``obj`` rest in / on ``support`` centred at ``center`` with box ``size`` (folded cloth; what
         rests on it moves along), out of the gripper if it was held."""
         obj.parent, obj.relation, obj.room, obj.size = support.name, relation, support.room, size

@@ -28,8 +28,9 @@ def colorize_semantic(semantic: np.ndarray, class_names: list[str]) -> np.ndarra
     return class_colors(class_names)[semantic]
 
 
-def frame_pictures(rgb: np.ndarray, depth: np.ndarray, semantic: np.ndarray, class_names: list[str],
-                   max_range_m: float = MAX_RANGE_M) -> dict[str, np.ndarray]:
+def frame_pictures(
+    rgb: np.ndarray, depth: np.ndarray, semantic: np.ndarray, class_names: list[str], max_range_m: float = MAX_RANGE_M
+) -> dict[str, np.ndarray]:
     """The three pictures of a camera frame, (H, W, 3) uint8 each: ``rgb``, ``depth`` and ``semantic`` colourised."""
     return {
         "rgb": np.asarray(rgb, dtype=np.uint8),

@@ -27,8 +27,9 @@ def scene_graph_png(graph: SceneGraph, *, title: str | None = None, dpi: int = 1
     occ = graph.occupancy
     if occ is not None:
         x0, y0, x1, y1 = occ.frame.bounds(occ.grid.shape)
-        ax.imshow(occ.grid.T, origin="lower", extent=(x0, x1, y0, y1), cmap=_OCC_CMAP, vmin=0, vmax=2,
-                  interpolation="nearest")  # imshow draws [row, col]: y up the rows
+        ax.imshow(
+            occ.grid.T, origin="lower", extent=(x0, x1, y0, y1), cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest"
+        )  # imshow draws [row, col]: y up the rows
         known = np.argwhere(occ.grid != 0)
         if len(known):  # show the explored part, with a metre around it
             margin = occ.resolution_m / 2 + 1.0
@@ -56,8 +57,17 @@ def scene_graph_png(graph: SceneGraph, *, title: str | None = None, dpi: int = 1
     for obj in graph.objects.values():
         low, high = obj.bbox.min, obj.bbox.max
         door = obj.category == "door"
-        ax.add_patch(plt.Rectangle((low[0], low[1]), high[0] - low[0], high[1] - low[1], fill=False,
-                                   edgecolor="#ff00ff" if door else "#1f77b4", linewidth=1.5, zorder=4))
+        ax.add_patch(
+            plt.Rectangle(
+                (low[0], low[1]),
+                high[0] - low[0],
+                high[1] - low[1],
+                fill=False,
+                edgecolor="#ff00ff" if door else "#1f77b4",
+                linewidth=1.5,
+                zorder=4,
+            )
+        )
         ax.annotate(obj.label, (obj.position[0], obj.position[1]), fontsize=7, zorder=5)
     rx, ry = graph.robot.position
     ax.scatter([rx], [ry], marker="^", s=120, color="#d62728", edgecolors="k", label="robot", zorder=6)

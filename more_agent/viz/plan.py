@@ -58,20 +58,45 @@ def draw_plan(
         is_open = state.get(d.id, d.open)
         ax.add_patch(_rect(d.bounds(), facecolor=_OPEN_DOOR if is_open else _CLOSED_DOOR, edgecolor="none", zorder=4))
     for f in scene.furniture:
-        b = (f.center[0] - f.size[0] / 2, f.center[1] - f.size[1] / 2, f.center[0] + f.size[0] / 2, f.center[1] + f.size[1] / 2)
-        ax.add_patch(_rect(b, facecolor=_OPENABLE if f.openable else _FURNITURE, edgecolor="black",
-                           linewidth=0.3, alpha=0.85, zorder=2 + f.center[2] / 10))
+        b = (
+            f.center[0] - f.size[0] / 2,
+            f.center[1] - f.size[1] / 2,
+            f.center[0] + f.size[0] / 2,
+            f.center[1] + f.size[1] / 2,
+        )
+        ax.add_patch(
+            _rect(
+                b,
+                facecolor=_OPENABLE if f.openable else _FURNITURE,
+                edgecolor="black",
+                linewidth=0.3,
+                alpha=0.85,
+                zorder=2 + f.center[2] / 10,
+            )
+        )
         if label_furniture:
             ax.text(f.center[0], f.center[1], f.id, fontsize=4, ha="center", va="center", zorder=6)
     for r in scene.rooms:
         cx, cy = (r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2
-        ax.text(cx, cy, r.id, fontsize=8, ha="center", va="center", zorder=7,
-                bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.7, linewidth=0))
+        ax.text(
+            cx,
+            cy,
+            r.id,
+            fontsize=8,
+            ha="center",
+            va="center",
+            zorder=7,
+            bbox=dict(boxstyle="round,pad=0.2", facecolor="white", alpha=0.7, linewidth=0),
+        )
     if legend:
         handles = [Patch(color=c, label=g) for g, c in GROUND_COLOURS.items()] + [
-            Patch(color=_WALL, label="wall"), Patch(color=_FENCE, label="fence"), Patch(color=_WINDOW, label="window"),
-            Patch(color=_OPEN_DOOR, label="open door"), Patch(color=_CLOSED_DOOR, label="closed door"),
-            Patch(color=_FURNITURE, label="furniture"), Patch(color=_OPENABLE, label="openable furniture"),
+            Patch(color=_WALL, label="wall"),
+            Patch(color=_FENCE, label="fence"),
+            Patch(color=_WINDOW, label="window"),
+            Patch(color=_OPEN_DOOR, label="open door"),
+            Patch(color=_CLOSED_DOOR, label="closed door"),
+            Patch(color=_FURNITURE, label="furniture"),
+            Patch(color=_OPENABLE, label="openable furniture"),
         ]
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.set_xlim(scene.bounds[0], scene.bounds[2])

@@ -41,12 +41,22 @@ def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) 
     ax.plot([o.center[0] for o in items], [o.center[1] for o in items], ".", color="black", ms=4, zorder=9)
     for obj in items:
         if labelled is None or obj.name in labelled:
-            ax.annotate(world.display_label(obj.name), (obj.center[0], obj.center[1]), fontsize=5, zorder=9,
-                        xytext=(2, 2), textcoords="offset points")
+            ax.annotate(
+                world.display_label(obj.name),
+                (obj.center[0], obj.center[1]),
+                fontsize=5,
+                zorder=9,
+                xytext=(2, 2),
+                textcoords="offset points",
+            )
 
 
 def trajectory_map_png(
-    world: World, trajectory: Sequence[tuple[float, float]], *, title: str = "", dpi: int = 120,
+    world: World,
+    trajectory: Sequence[tuple[float, float]],
+    *,
+    title: str = "",
+    dpi: int = 120,
     labelled: Collection[str] | None = None,
 ) -> bytes:
     """The plan of ``world`` (doors and furniture as they are now), its items and the robot's path, as PNG bytes."""

@@ -16,6 +16,17 @@ from more_agent.planners.policies.skills import (
 )
 
 __all__ = [
-    "SUBPOLICIES", "Area", "Embodiment", "PolicyConfig", "agent_nav_grid", "explore", "explore_frontiers", "go_to_and",
-    "navigate", "object_goal", "path_to_nearest", "pick_target", "run_skill",
+    "SUBPOLICIES",
+    "Area",
+    "Embodiment",
+    "PolicyConfig",
+    "agent_nav_grid",
+    "explore",
+    "explore_frontiers",
+    "go_to_and",
+    "navigate",
+    "object_goal",
+    "path_to_nearest",
+    "pick_target",
+    "run_skill",
 ]

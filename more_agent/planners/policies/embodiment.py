@@ -40,19 +40,25 @@ class PolicyConfig(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     plan_inflation_m: float = Field(
-        default=ROBOT.radius_m + PLAN_MARGIN_M, gt=0,
-        description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin)."
+        default=ROBOT.radius_m + PLAN_MARGIN_M,
+        gt=0,
+        description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin).",
     )
     sense_every_steps: int = Field(default=4, ge=1, description="Fuse a frame after this many forward moves on a path.")
-    max_replans: int = Field(default=3, ge=0, description="Replans on the updated map after a blocked move before giving up.")
+    max_replans: int = Field(
+        default=3, ge=0, description="Replans on the updated map after a blocked move before giving up."
+    )
     goal_snap_m: float = Field(
-        default=1.0, gt=0, description="A goal off the traversable map moves to the nearest traversable cell within this distance."
+        default=1.0,
+        gt=0,
+        description="A goal off the traversable map moves to the nearest traversable cell within this distance.",
     )
     visited_frontier_m: float = Field(
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
     blind_radius_m: float = Field(
-        default_factory=lambda: Camera().blind_floor_m, ge=0,
+        default_factory=lambda: Camera().blind_floor_m,
+        ge=0,
         description="Unknown cells this close to where the robot has been count as free on its map: the camera "
         "never sees the floor this close to the robot (``Camera.blind_floor_m``, 0.95 m for the Fetch's head camera).",
     )
@@ -109,17 +115,24 @@ class Embodiment:
             self.on_frame(frame)
         table = instance_table(self.world, frame.instance)
         infos = {
-            i: InstanceInfo(label=d["label"], category=d["category"], open=d["open"], held=d["held"],
-                            rests=self._rests(d["name"]))
+            i: InstanceInfo(
+                label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
+            )
             for i, d in table.items()
         }
         released = self._held if self._held is not None and self._held != self.world.robot.held else None
         for name in [*acted_on, *([released] if released is not None else [])]:
             obj = self.world.get(name)
-            infos.setdefault(obj.instance_id, InstanceInfo(
-                label=obj.label, category=obj.category, open=obj.is_open if obj.openable else None,
-                held=self.world.robot.held == name, rests=self._rests(name),
-            ))
+            infos.setdefault(
+                obj.instance_id,
+                InstanceInfo(
+                    label=obj.label,
+                    category=obj.category,
+                    open=obj.is_open if obj.openable else None,
+                    held=self.world.robot.held == name,
+                    rests=self._rests(name),
+                ),
+            )
         if released is not None:
             for obj in [self.world.get(released), *self.world.descendants(released)]:  # with what rode on it
                 self.builder.remember(obj.instance_id, *obj.box())
@@ -131,10 +144,16 @@ class Embodiment:
         """``result`` with the low-level steps and path the robot made since the previous call (the first
         call's include the initial full turn): what one high-level step reports to the episode loop."""
         steps, self._reported_steps = self.low_level_steps - self._reported_steps, self.low_level_steps
-        path = self.trajectory[self._reported_path - 1:] if len(self.trajectory) > self._reported_path else []
+        path = self.trajectory[self._reported_path - 1 :] if len(self.trajectory) > self._reported_path else []
         self._reported_path = len(self.trajectory)
-        return ActionResult(ok=result.ok, reason=result.reason, feedback=result.feedback, low_level_steps=steps,
-                            path=path, blocking=result.blocking)
+        return ActionResult(
+            ok=result.ok,
+            reason=result.reason,
+            feedback=result.feedback,
+            low_level_steps=steps,
+            path=path,
+            blocking=result.blocking,
+        )
 
     def _rests(self, name: str) -> tuple[Relation, str | None] | None:
         """How a seen object rests, as perception reports it: the world's support link (what the last
@@ -156,8 +175,14 @@ class Embodiment:
         (the oracle passes them to :meth:`add_motion`, the subpolicies to :meth:`record_jump`)."""
         info = self._step(kind, target=target)
         reason = FailureReason(info["reason"]) if info["reason"] else None
-        return ActionResult(ok=info["action_ok"], reason=reason, feedback=info["feedback"],
-                            low_level_steps=info["low_level_steps"], path=info["path"], blocking=info["blocking"])
+        return ActionResult(
+            ok=info["action_ok"],
+            reason=reason,
+            feedback=info["feedback"],
+            low_level_steps=info["low_level_steps"],
+            path=info["path"],
+            blocking=info["blocking"],
+        )
 
     def _step(self, kind: str, *, target: str = "", amount: float | None = None) -> dict[str, Any]:
         """``env.step`` of action type ``kind`` (:data:`~more_agent.sim.env.ACTION_TYPES`); its info."""

@@ -27,8 +27,13 @@ from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
 
 
 def agent_nav_grid(
-    occupancy: OccupancyMap, *, inflation_m: float, stood_xy: Sequence[XY] = (), blind_radius_m: float = 0.0,
-    bumped_xy: Sequence[XY] = (), retrace: bool = False,
+    occupancy: OccupancyMap,
+    *,
+    inflation_m: float,
+    stood_xy: Sequence[XY] = (),
+    blind_radius_m: float = 0.0,
+    bumped_xy: Sequence[XY] = (),
+    retrace: bool = False,
 ) -> NavGrid:
     """The traversable raster of the agent's map: seen-free cells, and unknown cells within
     ``blind_radius_m`` of a position in ``stood_xy``, at least ``inflation_m`` from obstacles (mapped
@@ -50,8 +55,11 @@ def agent_nav_grid(
     if retrace:
         free[path[:, 0], path[:, 1]] |= grid[path[:, 0], path[:, 1]] != OCCUPIED
     return NavGrid(
-        origin_xy=occupancy.origin_xy, resolution_m=occupancy.resolution_m, free=free,
-        closed_doors=frozenset(), door_cells={},
+        origin_xy=occupancy.origin_xy,
+        resolution_m=occupancy.resolution_m,
+        free=free,
+        closed_doors=frozenset(),
+        door_cells={},
     )
 
 

@@ -32,7 +32,9 @@ def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
     return ActionResult(ok=False, reason=reason, feedback=feedback, low_level_steps=steps)
 
 
-def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None) -> tuple[bool, int | None, str]:
+def _drive(
+    body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None
+) -> tuple[bool, int | None, str]:
     """Drive to the nearest reachable goal on the agent's map (goals off it snapped within ``snap_m``,
     default ``goal_snap_m``), replanning on the updated map when a move is blocked. Returns (reached,
     goal index, failure feedback)."""
@@ -51,14 +53,22 @@ def _drive(body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: flo
     return False, None, "the way is blocked"
 
 
-def _plan(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float) -> tuple[PathResult, int | None]:
+def _plan(
+    body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float
+) -> tuple[PathResult, int | None]:
     """Shortest path on the agent's map to the nearest reachable goal; when none is, the same with the
     robot retracing its own path (``agent_nav_grid``'s ``retrace``): paths keep the full clearance
     margin wherever they can, and the robot is never sealed in where a final approach left it."""
     cfg = body.config
     for retrace in (False, True):
-        grid = agent_nav_grid(occupancy, inflation_m=cfg.plan_inflation_m, stood_xy=body.trajectory,
-                              blind_radius_m=cfg.blind_radius_m, bumped_xy=body.bumps, retrace=retrace)
+        grid = agent_nav_grid(
+            occupancy,
+            inflation_m=cfg.plan_inflation_m,
+            stood_xy=body.trajectory,
+            blind_radius_m=cfg.blind_radius_m,
+            bumped_xy=body.bumps,
+            retrace=retrace,
+        )
         path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
         if index is not None:
             break
@@ -84,8 +94,11 @@ def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[
     if not reached:
         if index is None:  # no frontier reachable: do not offer them again
             body.visited_frontiers.extend(frontiers)
-        return _fail(FailureReason.NOT_REACHABLE, f"cannot reach an unexplored area of {room}: {why}",
-                     body.low_level_steps - start)
+        return _fail(
+            FailureReason.NOT_REACHABLE,
+            f"cannot reach an unexplored area of {room}: {why}",
+            body.low_level_steps - start,
+        )
     if body.config.look_around_at_frontier:
         body.look_around()
     return ActionResult(ok=True, reason=None, feedback=f"explored {room}", low_level_steps=body.low_level_steps - start)
@@ -108,7 +121,9 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
     if not reached:
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: {why}", body.low_level_steps - start)
     body.face(target.position[:2])
-    return ActionResult(ok=True, reason=None, feedback=f"reached {target.label}", low_level_steps=body.low_level_steps - start)
+    return ActionResult(
+        ok=True, reason=None, feedback=f"reached {target.label}", low_level_steps=body.low_level_steps - start
+    )
 
 
 def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode) -> ActionResult:
@@ -126,8 +141,11 @@ def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode
     if result.ok:
         body.sense(acted_on=(name,))  # what opening / placing revealed; the new state even out of view
     return ActionResult(
-        ok=result.ok, reason=result.reason, feedback=result.feedback,
-        low_level_steps=body.low_level_steps - start, blocking=result.blocking,
+        ok=result.ok,
+        reason=result.reason,
+        feedback=result.feedback,
+        low_level_steps=body.low_level_steps - start,
+        blocking=result.blocking,
     )
 
 
@@ -166,7 +184,9 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     if result.ok:
         body.sense()  # the hand is empty now: without a frame the graph would still show the item held
     feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"
-    return ActionResult(ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start)
+    return ActionResult(
+        ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start
+    )
 
 
 def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:
@@ -174,7 +194,9 @@ def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m
     if not visited:
         return graph
     regions = {
-        rid: r.model_copy(update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]})
+        rid: r.model_copy(
+            update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]}
+        )
         for rid, r in graph.regions.items()
     }
     return graph.model_copy(update={"regions": regions})
@@ -238,7 +260,10 @@ def _cannot(skill: Skill, target: Target) -> ActionResult:
 
 
 SUBPOLICIES: dict[Subpolicy, SubpolicyFn] = {
-    "explore": _explore, "navigate": _navigate, "go_to_and": _go_to_and, "done": _done,
+    "explore": _explore,
+    "navigate": _navigate,
+    "go_to_and": _go_to_and,
+    "done": _done,
 }
 """The planners' binding of the skill table's subpolicies (:attr:`more_agent.skills.Skill.subpolicy`)
 to the functions that run them."""
