@@ -16,14 +16,20 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from more_agent.sim import catalog
 from more_agent.sim.tasks import ParsedLiteral, TaskDefinition, atoms, literal_text, scope_synset
 from more_agent.sim.world import World
 
-if TYPE_CHECKING:
-    from more_agent.sim.instantiate import TaskInstance
+
+class DescribedTask(Protocol):
+    """What these functions read of a task instance (``instantiate.TaskInstance``)."""
+
+    world: World
+    definition: TaskDefinition
+    scope: dict[str, str]
+    description_template: str
 
 SCOPE_NAME = r"[\w.]+?\.n\.\d+_(?:\d+|\*)"
 """A bddl scope name: 'apple.n.01_1', or 'cabinet.n.01_*' (a scope of any one instance)."""
@@ -43,7 +49,7 @@ class ScopeGroup:
     """None for scopes written in the goal; else the quantifier ('forall', 'exists', ...)."""
 
 
-def described_scopes(instance: TaskInstance) -> set[str]:
+def described_scopes(instance: DescribedTask) -> set[str]:
     """Scopes whose instance the description names (:func:`template_scopes` of its template)."""
     return template_scopes(instance.description_template, instance.definition, instance.world, instance.scope)
 
@@ -69,7 +75,7 @@ def scope_categories(scope: str) -> frozenset[str]:
     return frozenset(catalog.synset_categories(synset)) | {synset.split(".")[0]}
 
 
-def ambiguous_scopes(instance: TaskInstance) -> list[str]:
+def ambiguous_scopes(instance: DescribedTask) -> list[str]:
     """The goal scopes the instance's description cannot single out (module docstring), sorted."""
     return ambiguous_in(instance.world, instance.definition, instance.scope, described_scopes(instance))
 
@@ -97,11 +103,17 @@ def ambiguous_in(world: World, definition: TaskDefinition, scope: Mapping[str, s
         ]
         unnamed = [s for s in members if s not in described]
         is_moved = any(s in moved for s in members) or (group.quantifier is not None and _variable_moved(goal, members))
+<<<<<<< HEAD
         if (
             not unnamed
             or (group.quantifier == "forall" and not is_moved)
             or (group.quantifier == "exists" and len(unnamed) < len(members))
         ):
+=======
+        addressed_all = group.quantifier == "forall" and not is_moved
+        one_named = group.quantifier == "exists" and len(unnamed) < len(members)
+        if not unnamed or addressed_all or one_named:
+>>>>>>> issue-25
             continue
         own = {scope[s] for s in members}
         categories = scope_categories(members[0])
