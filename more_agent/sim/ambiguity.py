@@ -31,6 +31,7 @@ class DescribedTask(Protocol):
     scope: dict[str, str]
     description_template: str
 
+
 SCOPE_NAME = r"[\w.]+?\.n\.\d+_(?:\d+|\*)"
 """A bddl scope name: 'apple.n.01_1', or 'cabinet.n.01_*' (a scope of any one instance)."""
 SCOPE_WORD = re.compile(rf"\$({SCOPE_NAME})")
@@ -103,17 +104,9 @@ def ambiguous_in(world: World, definition: TaskDefinition, scope: Mapping[str, s
         ]
         unnamed = [s for s in members if s not in described]
         is_moved = any(s in moved for s in members) or (group.quantifier is not None and _variable_moved(goal, members))
-<<<<<<< HEAD
-        if (
-            not unnamed
-            or (group.quantifier == "forall" and not is_moved)
-            or (group.quantifier == "exists" and len(unnamed) < len(members))
-        ):
-=======
         addressed_all = group.quantifier == "forall" and not is_moved
         one_named = group.quantifier == "exists" and len(unnamed) < len(members)
         if not unnamed or addressed_all or one_named:
->>>>>>> issue-25
             continue
         own = {scope[s] for s in members}
         categories = scope_categories(members[0])
