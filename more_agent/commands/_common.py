@@ -32,7 +32,6 @@ from rich.text import Text
 
 from more_agent.errors import UserError, check_writable_dir
 from more_agent.interrupts import interrupted, signal_exit_status, signals_remembered
-from more_agent.llm.limits import MAX_LOG_CHARS, clip
 from more_agent.records import EpisodeRecord
 from more_agent.redaction import for_terminal
 from more_agent.safe_files import DISK_FULL_ERRNOS, path_error
@@ -104,9 +103,10 @@ class _SafeStderrHandler(logging.Handler):
     """Log lines of the package on the current stderr, redacted and clipped (they may quote a server)."""
 
     def emit(self, record: logging.LogRecord) -> None:
-        # imported here: the llm package is slow to import, and most commands never log
-
         try:
+            # imported here: the llm package is slow to import, and most commands never log
+            from more_agent.llm.limits import MAX_LOG_CHARS, clip
+
             sys.stderr.write(f"{record.levelname.lower()}: {clip(for_terminal(record.getMessage()), MAX_LOG_CHARS)}\n")
         except Exception:  # noqa: BLE001 - logging must never take the program down
             self.handleError(record)

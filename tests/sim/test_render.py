@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from more_agent.robot_spec import OMNIGIBSON_FETCH_HFOV_DEG
 from more_agent.sim.camera import Camera, camera_pose, project
 from more_agent.sim.render import Renderer, instance_table, render, scene_geometry
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall, Window
@@ -67,9 +68,10 @@ def test_camera_pose_is_a_pitched_opencv_frame():
     assert np.allclose(R[:, 2], [0, math.cos(math.radians(20)), -math.sin(math.radians(20))])  # forward: north, down
     assert np.allclose(R[:, 0], [1, 0, 0])  # right of north is east
     K = Camera().intrinsics()
-    # OmniGibson's camera: 17 mm focal length over a 20.955 mm aperture, 63.3 deg horizontal FOV
-    assert K[0, 0] == pytest.approx(128 * 17.0 / (20.955 / 2)) and K[0, 2] == pytest.approx(127.5)
-    assert math.degrees(2 * math.atan(128 / K[0, 0])) == pytest.approx(63.3, abs=0.05)
+    assert K[0, 0] == pytest.approx(128.0) and K[0, 2] == pytest.approx(127.5)  # 90 deg horizontal FOV
+    # OmniGibson's Fetch: a 17 mm focal length over a 20.955 mm aperture
+    assert OMNIGIBSON_FETCH_HFOV_DEG == pytest.approx(63.3, abs=0.05)
+    assert Camera(hfov_deg=OMNIGIBSON_FETCH_HFOV_DEG).blind_floor_m == pytest.approx(0.95, abs=0.005)
 
 
 def test_depth_to_a_wall_at_a_known_distance():
