@@ -127,7 +127,7 @@ def scope_groups(goal: list[ParsedLiteral], objects: Mapping[str, list[str]]) ->
     (the task's scopes of its synset), then each scope written in the goal with its twins (scopes of
     its synset whose exchange leaves the goal unchanged: "put the two apples in the fridge")."""
     groups = [ScopeGroup(tuple(objects.get(synset, ())), quantifier) for quantifier, synset in _quantified(goal)]
-    written = sorted({t.lstrip("?") for atom in atoms(goal) for t in atom[1:] if _is_scope(t.lstrip("?"))})
+    written = sorted(written_scopes(goal))
     seen: set[str] = set()
     for s in written:
         if s in seen:
@@ -157,8 +157,9 @@ def _variable_moved(goal: list[ParsedLiteral], members: list[str]) -> bool:
     return any(len(atom) == 3 and atom[1].lstrip("?") == synset for atom in atoms(goal))
 
 
-def _is_scope(term: str) -> bool:
-    return re.fullmatch(SCOPE_NAME, term) is not None
+def written_scopes(node: Any) -> set[str]:
+    """The scope names a (part of a) goal writes in its atoms; quantifier variables are no scopes."""
+    return {t.lstrip("?") for atom in atoms(node) for t in atom[1:] if re.fullmatch(SCOPE_NAME, t.lstrip("?"))}
 
 
 def _exchangeable(goal: list[ParsedLiteral], a: str, b: str) -> bool:

@@ -19,13 +19,12 @@ in both modes; ``named`` adds the same instance names. Goals stay strict bddl ei
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Mapping
 from functools import cache
 from importlib import resources
 
 from more_agent.errors import unknown_name_error
-from more_agent.sim.ambiguity import SCOPE_NAME, ambiguous_in, scope_groups, template_scopes
+from more_agent.sim.ambiguity import ambiguous_in, scope_groups, template_scopes, written_scopes
 from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal, scope_synset
 from more_agent.sim.world import World
 
@@ -69,7 +68,7 @@ def naming_sentences(definition: TaskDefinition, ambiguous: list[str]) -> str:
     if not ambiguous:
         return ""
     wanted = set(ambiguous)
-    conditions = [c for c in definition.goal if wanted & _written_scopes(c)]
+    conditions = [c for c in definition.goal if wanted & written_scopes(c)]
     out = [f"To be exact: {describe_goal(conditions, _scope_word)}."] if conditions else []
     for group in scope_groups(definition.goal, definition.objects):
         if group.quantifier is not None and wanted & set(group.scopes):
@@ -81,14 +80,6 @@ def naming_sentences(definition: TaskDefinition, ambiguous: list[str]) -> str:
 
 def _scope_word(scope: str) -> str:
     return f"${scope}"
-
-
-def _written_scopes(node: object) -> set[str]:
-    """The scope names written anywhere in a parse tree (quantifier variables are no scopes)."""
-    if isinstance(node, str):
-        name = node.lstrip("?")
-        return {name} if re.fullmatch(SCOPE_NAME, name) else set()
-    return set().union(*(_written_scopes(x) for x in node)) if isinstance(node, list) else set()
 
 
 def _sentences(text: str, more: str) -> str:
