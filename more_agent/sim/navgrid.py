@@ -7,14 +7,10 @@ non-physical steps where collisions would be unavoidable (S.2). The radius (0.2 
 smaller than Fetch's ~0.28 m base) is chosen so that 0.9 m doors and 0.8 m corridors stay passable.
 
 Grids depend only on the world's fixed geometry and on which doors are closed, so they are cached
-per (world, closed doors, config). Paths are 8-connected geometric shortest paths (``skimage.graph.MCP_Geometric``),
-simplified to polylines (``sim.paths``, which the planners use on their own maps too). ``blocking_door`` names the closed door on the way when a goal is only
-reachable with doors open: the magic actions report it so that a planner knows what to open.
-
-Rasters are ``free[ix, iy]`` on a :class:`~more_agent.sim.grid.Grid`. The searches (nearest free
-cell, shortest path, its simplification) run on the raster transposed to ``[iy, ix]``: how they
-break ties between equally good cells depends on the layout, and every recorded episode was made
-with that one. Cells go in and come out as (ix, iy).
+per (world, closed doors, config). Shortest paths on them are :mod:`more_agent.sim.paths`' (the
+planners search their own maps with it too, without the world). ``blocking_door`` names the closed
+door on the way when a goal is only reachable with doors open: the magic actions report it so that a
+planner knows what to open.
 """
 
 from __future__ import annotations
