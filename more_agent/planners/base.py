@@ -26,6 +26,7 @@ from more_agent.records import DEFAULT_HISTORY, HistoryMode, LLMUsage
 from more_agent.robot import Robot
 
 if TYPE_CHECKING:
+    from more_agent.planners.targets import Target
     from more_agent.robot import ActionResult
     from more_agent.scene_graph import SceneGraph
 
@@ -53,10 +54,15 @@ def default_planner(llm: str | None) -> str:
 
 @dataclass(frozen=True)
 class HighLevelAction:
-    """One planner decision: a subpolicy / magic action name and its arguments (world object names)."""
+    """One planner decision, typed: a skill of the table (or a magic action of the oracle), its arguments
+    as words (room, object label: what the record and the LLM's history show) and what it acts on as a
+    typed target (``planners.targets``: an object node, an area, an unresolved name), which ``execute``
+    runs as it is."""
 
     name: str
     arguments: tuple[str, ...] = ()
+    target: Target = None
+    """What the skill acts on (None for done, and for the oracle, which acts on world names)."""
     note: str = ""
     """Why the planner chose it (an LLM's reasoning, the oracle's goal literal)."""
     gave_up: str = ""

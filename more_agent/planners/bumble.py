@@ -50,9 +50,10 @@ from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
 from more_agent.planners.llm_planner import filter_view, make_clients
-from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
+from more_agent.planners.policies import Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
+from more_agent.planners.targets import Area, Unresolved
 from more_agent.planners.visual_memory import (
     MemoryConfig,
     MemoryFrame,
@@ -76,8 +77,8 @@ from more_agent.planners.vlm_prompts import (
     step_messages,
 )
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
-from more_agent.robot import XY, ActionResult, Frame
-from more_agent.scene_graph import SceneGraph
+from more_agent.robot import ActionResult, Frame
+from more_agent.scene_graph import ObjectNode, SceneGraph
 from more_agent.skills import INVALID
 
 log = logging.getLogger(__name__)
@@ -108,19 +109,6 @@ BUMBLE_CONFIGS: dict[str, BumbleConfig] = {
     "bumble-filter": BumbleConfig(name="bumble-filter", filtering=True),
 }
 """The paper's two BUMBLE planners by name."""
-
-
-@dataclass(frozen=True)
-class Decision:
-    """What the parameter steps resolved for the decided action."""
-
-    subtask: str = ""
-    target: str | None = None
-    """Scene-graph object id to act on (navigate / go_to_and_*)."""
-    frontiers: tuple[XY, ...] = ()
-    """Unexplored areas seen in the chosen frame (explore)."""
-    failure: str = ""
-    """Why no target could be offered (nothing seen yet, no unexplored area in memory)."""
 
 
 @dataclass(frozen=True)
@@ -174,7 +162,6 @@ class BumblePlanner:
         """Object ids the filter kept (``bumble-filter``), None without filtering."""
         self.current: Frame | None = None
         """The latest rendered frame: the current view."""
-        self.decision = Decision()
         self.step_log = StepLog()
 
     # -- Planner protocol ---------------------------------------------------------------------
@@ -209,17 +196,15 @@ class BumblePlanner:
 
     def decide(self) -> HighLevelAction:
         """Step decision, then the skill's parameter steps; ``invalid`` when an answer stays unusable."""
-        self.decision = Decision()
         try:
             skill, subtask = self._ask(self._step_messages(), StepAnswer, parse_step, "plan")
             if skill == DONE:
                 return HighLevelAction(name=DONE, note=subtask)
-            self.decision = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
+            target = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
         except InvalidAnswer as e:
             return HighLevelAction(name=INVALID, note=e.reason)
-        target = self.decision.target
-        arguments = (self._graph().objects[target].label,) if target is not None else ()
-        return HighLevelAction(name=skill, arguments=arguments, note=subtask)
+        arguments = (target.label,) if isinstance(target, ObjectNode) else ()
+        return HighLevelAction(name=skill, arguments=arguments, target=target, note=subtask)
 
     def execute(self, action: HighLevelAction) -> ActionResult:
         """Run the subpolicy (explorations get the VLM's verdict as feedback)."""
@@ -297,7 +282,7 @@ class BumblePlanner:
             history_mode=self.history_mode,
         )
 
-    def _object_target(self, subtask: str) -> Decision:
+    def _object_target(self, subtask: str) -> ObjectNode | Unresolved:
         """Landmark step (which frame), then object step (which mark in it)."""
         frames = self.memory.frames
         wanted = {
@@ -305,7 +290,7 @@ class BumblePlanner:
         }
         offered = covering_frames(frames, wanted, self.config.memory.max_images)
         if not offered:
-            return Decision(subtask=subtask, failure="no object to go to has been seen yet")
+            return Unresolved(FailureReason.INVALID_TARGET, "no object to go to has been seen yet")
         self.step_log.offered_frames = [f.index for f in offered]
         pictures = self._pictures(offered)
         k = self._ask(
@@ -329,9 +314,9 @@ class BumblePlanner:
             lambda a: parse_choice(a, "mark", len(marked)),
             "object",
         )
-        return Decision(subtask=subtask, target=marked[m - 1])
+        return self._graph().objects[marked[m - 1]]
 
-    def _explore_target(self, subtask: str) -> Decision:
+    def _explore_target(self, subtask: str) -> Area | Unresolved:
         """The frame whose unexplored areas to explore (among buffer frames showing some)."""
         graph = self._graph()
         points = np.array([f for r in graph.regions.values() for f in r.frontiers], dtype=float).reshape(-1, 2)
@@ -344,7 +329,7 @@ class BumblePlanner:
             showing, set(range(len(points))), self.config.memory.max_images, shown=lambda f: seen[f.index]
         )
         if not offered:
-            return Decision(subtask=subtask, failure="no unexplored area in view of the robot's memory")
+            return Unresolved(FailureReason.INVALID_TARGET, "no unexplored area in view of the robot's memory")
         self.step_log.offered_frames = [f.index for f in offered]
         k = self._ask(
             frames_messages("bumble_explore", task=self.task, subtask=subtask, pictures=self._pictures(offered)),
@@ -355,7 +340,7 @@ class BumblePlanner:
         chosen = offered[k - 1]
         self.step_log.frame = chosen.index
         frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
-        return Decision(subtask=subtask, frontiers=frontiers)
+        return Area("the chosen frame", frontiers=frontiers)
 
     def _verdict(self, subtask: str, frames: Sequence[MemoryFrame]) -> tuple[bool, str]:
         """(achieved, feedback) of an exploration, from the VLM shown the frames acquired during it.
@@ -406,18 +391,14 @@ class BumblePlanner:
             return ActionResult(
                 ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}"
             )
-        decision, body, graph = self.decision, self._body(), self._graph()
-        if action.name == DONE:
-            return run_skill(body, graph, DONE, None)
-        if decision.failure:
-            return ActionResult(ok=False, reason=FailureReason.INVALID_TARGET, feedback=decision.failure)
+        body, graph = self._body(), self._graph()
         if action.name != "explore":
-            return run_skill(body, graph, action.name, graph.objects[decision.target or ""])
+            return run_skill(body, graph, action.name, action.target)
         first = len(self.memory.frames)
-        result = run_skill(body, graph, action.name, Area("the chosen frame", frontiers=decision.frontiers))
+        result = run_skill(body, graph, action.name, action.target)
         if not result.ok:
             return result
-        achieved, feedback = self._verdict(decision.subtask, self.memory.since(first))
+        achieved, feedback = self._verdict(action.note, self.memory.since(first))
         return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
 
     # -- bookkeeping ----------------------------------------------------------------------------

@@ -93,15 +93,11 @@ Relation = tuple[str, str]
 
 @dataclass(frozen=True)
 class _Step:
-    """A decided action and how to run it."""
+    """A decided action (its typed target included), and whether it opens a container to look inside
+    (the search counts those in a row, ``OPENS_BEFORE_EXPLORING``)."""
 
     action: HighLevelAction
-    target: str | None = None
-    """Label of the object acted on (None for explore / floor placement)."""
-    region: str | None = None
-    """Region to explore or to put the held item down in."""
-    frontiers: tuple[XY, ...] | None = None
-    """The region's frontiers to explore (None: all of them)."""
+    looking: bool = False
 
 
 class GroundedPlanner:
@@ -151,7 +147,6 @@ class GroundedPlanner:
         self.room_types: dict[str, str] = {}
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
-        self._step: _Step | None = None
         self.body.sense()
         self.body.look_around()
 
@@ -183,13 +178,12 @@ class GroundedPlanner:
 
     def decide(self) -> HighLevelAction:
         """``done`` when every goal literal holds as far as the robot knows, else the next action."""
-        self._step = self._decide()
-        looking = self._step.action.name == "go_to_and_open" and self._step.action.note.startswith("looking for")
-        self.opened_in_a_row = self.opened_in_a_row + 1 if looking else 0
-        return self._step.action
+        step = self._decide()
+        self.opened_in_a_row = self.opened_in_a_row + 1 if step.looking else 0
+        return step.action
 
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run the decided step's subpolicy."""
+        """Run the skill on the action's target, and learn from its outcome."""
         return self._run(action)
 
     def step_trace(self) -> StepTrace:
@@ -454,7 +448,7 @@ class GroundedPlanner:
     def _open_to_look(self, label: str, held: str | None, note: str) -> _Step:
         if held is not None:
             return self._put_down(held)
-        return self._object_step("go_to_and_open", label, note)
+        return _Step(self._object_step("go_to_and_open", label, note).action, looking=True)
 
     def _room_to_explore(self, missing: list[str], task_rooms: set[str]) -> str | None:
         """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
@@ -496,11 +490,8 @@ class GroundedPlanner:
 
     def _explore_step(self, region: str, note: str) -> _Step:
         far = far_frontiers(self._graph().frontiers(region), self.body.trajectory)
-        return _Step(
-            HighLevelAction("explore", (self.names[region],), note=note),
-            region=region,
-            frontiers=self._informative(far),
-        )
+        room = self.names[region]
+        return _Step(HighLevelAction("explore", (room,), Area(room, region, self._informative(far)), note=note))
 
     def _informative(self, frontiers: tuple[XY, ...]) -> tuple[XY, ...]:
         """The frontiers from which the most unknown floor lies in sensor range (``INFORMATIVE_SHARE``):
@@ -521,7 +512,8 @@ class GroundedPlanner:
         support = self._support_for(held) if self._off_floor(held, here) else None
         if support is not None:
             return self._object_step("go_to_and_place_ontop", support, note)
-        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(here), FLOOR), note=note))
+        room = self._room(here)
+        return _Step(HighLevelAction("go_to_and_place_ontop", (room, FLOOR), Area(room), note=note))
 
     def _off_floor(self, held: str, region: str | None) -> bool:
         """Whether a goal literal wants ``held`` off the floor of ``region`` (``not ontop`` a floor scope
@@ -559,51 +551,48 @@ class GroundedPlanner:
         return min(spots, key=lambda o: (o.region_id != here, math.dist(o.position[:2], self.body.xy), o.label)).label
 
     def _floor_step(self, region: str, note: str) -> _Step:
-        return _Step(HighLevelAction("go_to_and_place_ontop", (self._room(region), FLOOR), note=note), region=region)
+        room = self._room(region)
+        return _Step(HighLevelAction("go_to_and_place_ontop", (room, FLOOR), Area(room, region), note=note))
 
     def _object_step(self, skill: str, label: str, note: str) -> _Step:
         obj = self._graph().objects[label]
-        return _Step(HighLevelAction(skill, (self._room(obj.region_id), label), note=note), target=label)
+        return _Step(HighLevelAction(skill, (self._room(obj.region_id), label), obj, note=note))
 
     def _room(self, region_id: str | None) -> str:
         return self.names.get(region_id or "", "unknown")
 
     # -- acting -------------------------------------------------------------------------------
     def _run(self, action: HighLevelAction) -> ActionResult:
-        step, body, graph = self._step, self.body, self._graph()
-        if action.name == DONE or step is None:
+        body, graph, target = self.body, self._graph(), action.target
+        if action.name == DONE or target is None:
             return run_skill(body, graph, DONE, None)
         held = graph.held_object
-        if step.target is not None:
-            target: ObjectNode | Area = graph.objects[step.target]
-        else:
-            target = Area(action.arguments[0], step.region, step.frontiers)
         known = len(body.observed)
         result = run_skill(body, graph, action.name, target)
         news = len(body.observed) > known
-        if action.name == "explore":
-            assert step.region is not None
-            self.explored[step.region] += 1
-            self.fruitless[step.region] = 0 if news else self.fruitless[step.region] + 1
-        elif step.target is None and result.ok and held is not None:  # put on a floor
-            self.relation[held.label] = self._on_floor_of(step.region or graph.robot.region_id)
-        elif result.ok and action.name == "go_to_and_open":
-            self.looked_into.add(step.target)
+        if isinstance(target, Area):
+            if action.name == "explore":
+                assert target.region_id is not None
+                self.explored[target.region_id] += 1
+                self.fruitless[target.region_id] = 0 if news else self.fruitless[target.region_id] + 1
+            elif result.ok and held is not None:  # put on a floor
+                self.relation[held.label] = self._on_floor_of(target.region_id or graph.robot.region_id)
+        elif isinstance(target, ObjectNode):
+            if result.ok and action.name == "go_to_and_open":
+                self.looked_into.add(target.label)
+            if action.name == "navigate":
+                self.looked_at.add(target.label)
+                if news:  # its room shows more: explore it again
+                    self.fruitless[target.region_id or ""] = 0
         self.fruitless_looks = 0 if news else self.fruitless_looks + (action.name == "navigate")
-        if action.name == "navigate":
-            self.looked_at.add(step.target)
-            if news:  # its room shows more: explore it again
-                self.fruitless[graph.objects[step.target].region_id or ""] = 0
-        if not result.ok:
-            self._failed(action, step, result)
+        if not result.ok and isinstance(target, ObjectNode):
+            self._failed(action, target.label, result)
         return result
 
-    def _failed(self, action: HighLevelAction, step: _Step, result: ActionResult) -> None:
-        """Count a failure; an action failing twice the same way drops its target from the bindings."""
-        if step.target is None:
-            return
+    def _failed(self, action: HighLevelAction, label: str, result: ActionResult) -> None:
+        """Count a failure on the object ``label``; an action failing twice the same way drops it from the bindings."""
         if result.reason is FailureReason.NOT_REACHABLE:
-            self.out_of_reach[step.target] = len(self.body.trajectory)
+            self.out_of_reach[label] = len(self.body.trajectory)
             key, limit = (action.name, action.arguments, "not reachable"), MAX_REACH_FAILURES
         else:  # furniture cannot be picked up however often the robot tries
             limit = 1 if result.reason is FailureReason.NOT_GRASPABLE else MAX_FAILURES
@@ -611,9 +600,9 @@ class GroundedPlanner:
         self.failures[key] += 1
         if self.failures[key] < limit:
             return
-        self.dropped.add(step.target)
-        for scope, label in list(self.bound.items()):
-            if label == step.target and scope not in self.goal.named:
+        self.dropped.add(label)
+        for scope, bound in list(self.bound.items()):
+            if bound == label and scope not in self.goal.named:
                 del self.bound[scope]
 
     def _graph(self) -> SceneGraph:

@@ -54,8 +54,9 @@ from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
-from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
+from more_agent.planners.policies import Embodiment, PolicyConfig, pick_target, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
+from more_agent.planners.targets import Area, Target, Unresolved
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
 from more_agent.robot import ActionResult
 from more_agent.scene_graph import SceneGraph
@@ -191,7 +192,12 @@ class LLMPlanner:
         except InvalidAnswer as e:
             return HighLevelAction(name=INVALID, note=e.reason)
         planned = answer.value
-        return HighLevelAction(name=planned.skill, arguments=planned.arguments, note=planned.reasoning)
+        return HighLevelAction(
+            name=planned.skill,
+            arguments=planned.arguments,
+            target=self._target(planned.skill, planned.arguments),
+            note=planned.reasoning,
+        )
 
     def execute(self, action: HighLevelAction) -> ActionResult:
         """Run the subpolicy; its outcome is the next prompt's feedback."""
@@ -246,25 +252,26 @@ class LLMPlanner:
             self.clients.plan, self.task, view, max_reasks=self.config.max_reasks, always={view.robot_room}
         )
 
+    def _target(self, skill: str, arguments: tuple[str, ...]) -> Target:
+        """What the planned skill acts on: the room's area, or the object the names mean in the scene
+        text (of several, the one the skill can act on nearest the robot, where the graph has it); None for done."""
+        graph, view = self._graph(), self._view()
+        params = SKILLS_BY_NAME[skill].params
+        if not params:  # done
+            return None
+        room = arguments[0]
+        if "object" not in params or (arguments[1] == FLOOR and not view.resolve(room, FLOOR)):
+            return Area(room, view.room(room).region_id)
+        target = pick_target(graph, view.resolve(room, arguments[1]), skill, graph.robot.position)
+        return target or Unresolved(FailureReason.UNKNOWN_OBJECT, f"unknown object {arguments[1]}")
+
     def _run(self, action: HighLevelAction) -> ActionResult:
-        """Dispatch one decided action to its subpolicy."""
+        """Run the decided skill on its target."""
         if action.name == INVALID:
             return ActionResult(
                 ok=False, reason=FailureReason.INVALID_ANSWER, feedback=f"invalid answer: {action.note}"
             )
-        body, graph, view = self._body(), self._graph(), self._view()
-        params = SKILLS_BY_NAME[action.name].params
-        if not params:  # done
-            return run_skill(body, graph, action.name, None)
-        room = action.arguments[0]
-        if "object" not in params or (action.arguments[1] == FLOOR and not view.resolve(room, FLOOR)):
-            return run_skill(body, graph, action.name, Area(room, view.room(room).region_id))
-        target = pick_target(graph, view.resolve(room, action.arguments[1]), action.name, body.xy)
-        if target is None:
-            return ActionResult(
-                ok=False, reason=FailureReason.UNKNOWN_OBJECT, feedback=f"unknown object {action.arguments[1]}"
-            )
-        return run_skill(body, graph, action.name, target)
+        return run_skill(self._body(), self._graph(), action.name, action.target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def _body(self) -> Embodiment:

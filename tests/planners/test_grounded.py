@@ -15,13 +15,13 @@ from more_agent.planners.grounded import (
     OPENS_BEFORE_EXPLORING,
     GroundedPlanner,
     _on_floor,
-    _Step,
     far_frontiers,
 )
 from more_agent.planners.room_types import is_furniture, likely_room_type
+from more_agent.planners.targets import Area
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
-from more_agent.scene_graph import RegionNode
+from more_agent.scene_graph import ObjectNode, RegionNode
 from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
 from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
@@ -150,10 +150,11 @@ def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
     lit = planner.literals[0]
     step = planner._search(lit, None)
-    assert step.action.name == "explore" and step.frontiers
-    planner.fruitless[step.region] = FRUITLESS_EXPLORES - 1
+    area = step.action.target
+    assert step.action.name == "explore" and isinstance(area, Area) and area.frontiers and area.region_id
+    planner.fruitless[area.region_id] = FRUITLESS_EXPLORES - 1
     assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
-    planner.fruitless[step.region] = FRUITLESS_EXPLORES  # its last explores showed nothing new
+    planner.fruitless[area.region_id] = FRUITLESS_EXPLORES  # its last explores showed nothing new
     planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
     assert planner._search(lit, None).action.name == "go_to_and_open"
 
@@ -174,12 +175,12 @@ def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInst
     planner.observe()
     scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
     label = planner.bound[scope]
-    planner._step = _Step(HighLevelAction("go_to_and_grasp", ("kitchen_0", label)), target=label)
+    grasp = HighLevelAction("go_to_and_grasp", ("kitchen_0", label), planner.seen[label])
     hand = ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full")
-    planner._failed(planner._step.action, planner._step, hand)
+    planner._failed(grasp, label, hand)
     assert planner.bound[scope] == label  # one failure of another kind: tried again
     refused = ActionResult(ok=False, reason=FailureReason.NOT_GRASPABLE, feedback=f"{label} cannot be picked up")
-    planner._failed(planner._step.action, planner._step, refused)  # as if it were furniture
+    planner._failed(grasp, label, refused)  # as if it were furniture
     assert scope not in planner.bound and label in planner.dropped and planner._label(scope) != label
 
 
@@ -198,7 +199,8 @@ def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off
     planner.relation[item] = ("ontop", f"{FLOOR} kitchen")
     assert planner._holds(planner.literals[0]) is False
     support = planner._put_down(item)
-    assert support.target is not None and support.target != item and is_furniture(planner.seen[support.target].category)
+    target = support.action.target
+    assert isinstance(target, ObjectNode) and target.label != item and is_furniture(target.category)
 
 
 def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
@@ -221,10 +223,10 @@ def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> 
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING
     planner.fruitless[room] = FRUITLESS_EXPLORES
     step = planner._search(planner.literals[0], None)
-    assert step.action.name == "navigate" and planner.seen[step.target].region_id == room
-    planner._step = step
+    assert step.action.name == "navigate" and isinstance(step.action.target, ObjectNode)
+    assert step.action.target.region_id == room
     planner.execute(step.action)
-    assert planner._search(planner.literals[0], None).target != step.target  # each piece once
+    assert planner._search(planner.literals[0], None).action.target != step.action.target  # each piece once
 
 
 def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
@@ -300,9 +302,11 @@ def test_task_rooms_are_where_the_items_were_found_and_their_containers_are_open
     planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # the room's containers had their turn in a row
     lit = next(lit for lit in planner.literals if planner._label(lit.args[0]) is None)
     step = planner._search(lit, None)
-    assert step.action.name == "go_to_and_open" and planner.seen[step.target].region_id == kitchen_room
+    assert step.action.name == "go_to_and_open" and isinstance(step.action.target, ObjectNode)
+    assert step.action.target.region_id == kitchen_room
     planner.looked_into.update(planner.seen)  # every container of the kitchen looked into
-    assert planner._search(lit, None).region == far  # now the search moves on
+    later = planner._search(lit, None).action.target
+    assert isinstance(later, Area) and later.region_id == far  # now the search moves on
 
 
 def test_an_item_is_not_picked_up_for_a_floor_whose_room_is_not_found_yet() -> None:

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
+from more_agent.planners.targets import Area, Target, Unresolved
 from more_agent.records import FailureReason
 from more_agent.robot import XY, ActionResult
 from more_agent.robot_spec import ROBOT
@@ -204,21 +204,6 @@ def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m
 # -- dispatch through the skill table -----------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class Area:
-    """What an area skill acts on: a region's frontiers (explore) or floor (placing on it)."""
-
-    name: str
-    """How feedback names it: the room name the planner used."""
-    region_id: str | None = None
-    """The region; None for the floor where the robot stands."""
-    frontiers: tuple[XY, ...] | None = None
-    """The frontiers to explore instead of the region's own (BUMBLE explores those a chosen frame shows)."""
-
-
-Target = ObjectNode | Area | None
-"""What a skill acts on: a scene-graph object, an area, or nothing (done)."""
-
 SubpolicyFn = Callable[[Embodiment, SceneGraph, Skill, Target], ActionResult]
 """A subpolicy as the table dispatches to it: the robot, the step's scene graph, the skill, its target."""
 
@@ -269,6 +254,9 @@ to the functions that run them."""
 
 
 def run_skill(body: Embodiment, graph: SceneGraph, name: str, target: Target) -> ActionResult:
-    """Run the skill ``name`` of the table on ``target`` through its subpolicy."""
+    """Run the skill ``name`` of the table on ``target`` through its subpolicy (an ``Unresolved`` target
+    fails with its reason, running nothing)."""
+    if isinstance(target, Unresolved):
+        return _fail(target.reason, target.feedback)
     skill = skill_named(name)
     return SUBPOLICIES[skill.subpolicy](body, graph, skill, target)
