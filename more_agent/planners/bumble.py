@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections import Counter
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -48,7 +49,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
-from more_agent.planners.language import LanguageOptions, RoomText, SceneView, scene_view
+from more_agent.planners.language import LanguageOptions, RoomText, SceneView, room_names, scene_view
 from more_agent.planners.llm_planner import filter_view, make_clients
 from more_agent.planners.policies import Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
@@ -203,7 +204,9 @@ class BumblePlanner:
             target = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
         except InvalidAnswer as e:
             return HighLevelAction(name=INVALID, note=e.reason)
-        arguments = (target.label,) if isinstance(target, ObjectNode) else ()
+        arguments = (
+            (target.label,) if isinstance(target, ObjectNode) else (target.name,) if isinstance(target, Area) else ()
+        )
         return HighLevelAction(name=skill, arguments=arguments, target=target, note=subtask)
 
     def execute(self, action: HighLevelAction) -> ActionResult:
@@ -317,9 +320,11 @@ class BumblePlanner:
         return self._graph().objects[marked[m - 1]]
 
     def _explore_target(self, subtask: str) -> Area | Unresolved:
-        """The frame whose unexplored areas to explore (among buffer frames showing some)."""
+        """The unexplored areas of the frame the VLM picks (among buffer frames showing some), as the room
+        most of them lie in: the skill table's ``explore(room)``."""
         graph = self._graph()
         points = np.array([f for r in graph.regions.values() for f in r.frontiers], dtype=float).reshape(-1, 2)
+        owners = [rid for rid, r in graph.regions.items() for _ in r.frontiers]
         margin = self.config.memory.occlusion_margin_m
         seen = {
             f.index: set(np.flatnonzero(shows_points(f, points, margin_m=margin)).tolist()) for f in self.memory.frames
@@ -339,8 +344,11 @@ class BumblePlanner:
         )
         chosen = offered[k - 1]
         self.step_log.frame = chosen.index
-        frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in sorted(seen[chosen.index]))
-        return Area("the chosen frame", frontiers=frontiers)
+        picked = sorted(seen[chosen.index])
+        frontiers = tuple((float(points[i][0]), float(points[i][1])) for i in picked)
+        counts = Counter(owners[i] for i in picked)
+        region = min(counts, key=lambda rid: (-counts[rid], rid))
+        return Area(room_names(graph)[region], region, frontiers)
 
     def _verdict(self, subtask: str, frames: Sequence[MemoryFrame]) -> tuple[bool, str]:
         """(achieved, feedback) of an exploration, from the VLM shown the frames acquired during it.

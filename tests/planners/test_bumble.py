@@ -49,6 +49,14 @@ def solved(tmp_path_factory: pytest.TempPathFactory) -> tuple[EpisodeRecord, Bum
     return record, planner, server, tmp
 
 
+def test_explore_takes_the_room_its_chosen_frontiers_lie_in(solved: Any) -> None:
+    """The skill table's explore(room): the room of most frontiers the picked frame shows, named as the scene
+    text names rooms (BUMBLE labels none: unknown_room_<k>)."""
+    record = solved[0]
+    explores = [a for a in record.actions if a.name == "explore"]
+    assert explores and all(re.fullmatch(r"unknown_room_\d+", *a.arguments) for a in explores), explores
+
+
 def test_scripted_vlm_completes_the_episode(solved: Any) -> None:
     record, _, server, tmp = solved
     assert record.error is None and record.success and record.done_called, record.actions
