@@ -18,7 +18,7 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from more_agent.errors import UserError, unknown_name_error
 from more_agent.goal import GoalSpec
@@ -29,6 +29,8 @@ if TYPE_CHECKING:
     from more_agent.planners.targets import Target
     from more_agent.robot import ActionResult
     from more_agent.scene_graph import SceneGraph
+
+T = TypeVar("T")
 
 DONE = "done"
 """Name of the action that ends an episode."""
@@ -131,6 +133,14 @@ class Planner(Protocol):
 
     def llm_usage(self) -> LLMUsage:
         """LLM traffic of this episode so far."""
+
+
+def needed(value: T | None, call: str) -> T:
+    """``value``, set by a planner's ``call`` (``reset()``, ``observe()``), or a RuntimeError saying that
+    ``call`` has to come first: the one guard of every planner's per-episode and per-step state."""
+    if value is None:
+        raise RuntimeError(f"{call} must be called before this step of the planner")
+    return value
 
 
 PlannerFactory = Callable[[str | None], Planner]

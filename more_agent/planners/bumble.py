@@ -46,13 +46,12 @@ from more_agent.llm import InvalidAnswer, LLMClient, ask_validated
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace, needed
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, room_names, scene_view
 from more_agent.planners.llm_planner import filter_view, make_clients
 from more_agent.planners.policies import Embodiment, PolicyConfig, run_skill
-from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.planners.targets import Area, Unresolved
 from more_agent.planners.visual_memory import (
@@ -179,18 +178,14 @@ class BumblePlanner:
         self.task = context.goal.text
         self.history, self.subtasks, self.feedback, self.history_mode = [], [], "", context.history
         self.calls.new_episode()
-        self.body.sense()
-        self.body.look_around()
+        self.body.start()
 
     def observe(self) -> None:
         """Build the scene graph (map, objects, frontiers), describe its objects, filter them (``bumble-filter``)."""
-        body = self._body()
         self.memory.step = len(self.history)
         self.step_log = StepLog()
         self.calls.new_step()
-        self.graph = without_visited_frontiers(
-            body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m
-        )
+        self.graph = self._body().step_graph()
         view = scene_view(self.graph, LanguageOptions(instance_ids=True, spatial_relations=True))
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
         self.relevant = self._filter(view) if self.config.filtering else None
@@ -411,20 +406,13 @@ class BumblePlanner:
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def _body(self) -> Embodiment:
-        return _needed(self.body, "reset()")
+        return needed(self.body, "reset()")
 
     def _graph(self) -> SceneGraph:
-        return _needed(self.graph, "observe()")
+        return needed(self.graph, "observe()")
 
     def _current(self) -> Frame:
-        return _needed(self.current, "reset()")
-
-
-def _needed(value: T | None, call: str) -> T:
-    """``value``, or a RuntimeError saying that ``call`` has to come first."""
-    if value is None:
-        raise RuntimeError(f"{call} must be called before this step of the planner")
-    return value
+        return needed(self.current, "reset()")
 
 
 def make_bumble(llm: str | None) -> BumblePlanner:

@@ -50,11 +50,10 @@ import numpy as np
 
 from more_agent.goal import Literal, TaskGoal
 from more_agent.mapping import visible_unknown_area
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace, needed
 from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.language import room_names
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
-from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type
 from more_agent.records import FailureReason, LLMUsage
 from more_agent.robot import XY, ActionResult
@@ -147,22 +146,11 @@ class GroundedPlanner:
         self.room_types: dict[str, str] = {}
         self.graph: SceneGraph | None = None
         self.names: dict[str, str] = {}
-        self.body.sense()
-        self.body.look_around()
+        self.body.start()
 
     def observe(self) -> None:
         """Build the scene graph; remember what is seen, where it rests and its open state; type rooms."""
-        body = self.body
-        graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.visited_frontier_m)
-        labels = {}
-        for rid, region in graph.regions.items():
-            if region.room_label is None:
-                kind = likely_room_type(o.category for o in graph.objects_in(rid))
-                if kind is not None:
-                    labels[rid] = kind
-        if labels:
-            body.builder.set_room_labels(labels)
-            graph = graph.with_room_labels(labels)
+        graph = self.body.step_graph(_room_types)
         self.room_types = {rid: r.room_label for rid, r in graph.regions.items() if r.room_label}
         rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
         for obj in graph.objects.values():
@@ -606,9 +594,18 @@ class GroundedPlanner:
                 del self.bound[scope]
 
     def _graph(self) -> SceneGraph:
-        if self.graph is None:
-            raise RuntimeError("observe() must be called before decide() / execute()")
-        return self.graph
+        return needed(self.graph, "observe()")
+
+
+def _room_types(graph: SceneGraph) -> dict[str, str]:
+    """Region id -> the room type its furniture fits best, for the regions without a label."""
+    labels = {}
+    for rid, region in graph.regions.items():
+        if region.room_label is None:
+            kind = likely_room_type(o.category for o in graph.objects_in(rid))
+            if kind is not None:
+                labels[rid] = kind
+    return labels
 
 
 def _closes(lit: Literal) -> bool:

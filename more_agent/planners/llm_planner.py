@@ -50,12 +50,11 @@ from more_agent.llm import (
 )
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace, needed
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Embodiment, PolicyConfig, pick_target, run_skill
-from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.targets import Area, Target, Unresolved
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
 from more_agent.robot import ActionResult
@@ -151,19 +150,12 @@ class LLMPlanner:
         self.task = context.goal.text
         self.history, self.history_mode, self.feedback = [], context.history, ""
         self.calls.new_episode()
-        self.body.sense()
-        self.body.look_around()
+        self.body.start()
 
     def observe(self) -> None:
         """Build the scene graph, label new regions, put it into words."""
-        body = self._body()
         self.calls.new_step()
-        graph = without_visited_frontiers(body.build(), body.visited_frontiers, self.config.policy.visited_frontier_m)
-        labels = self._classify_rooms(graph)
-        if labels:
-            body.builder.set_room_labels(labels)
-            graph = graph.with_room_labels(labels)
-        self.graph = graph
+        graph = self.graph = self._body().step_graph(self._classify_rooms)
         self.view = scene_view(graph, self.config.language)
 
     def decide(self) -> HighLevelAction:
@@ -275,19 +267,13 @@ class LLMPlanner:
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def _body(self) -> Embodiment:
-        if self.body is None:
-            raise RuntimeError("reset() must be called before the first step")
-        return self.body
+        return needed(self.body, "reset()")
 
     def _graph(self) -> SceneGraph:
-        if self.graph is None:
-            raise RuntimeError("observe() must be called before decide() / execute()")
-        return self.graph
+        return needed(self.graph, "observe()")
 
     def _view(self) -> SceneView:
-        if self.view is None:
-            raise RuntimeError("observe() must be called before decide() / execute()")
-        return self.view
+        return needed(self.view, "observe()")
 
 
 def make_more(llm: str | None) -> LLMPlanner:

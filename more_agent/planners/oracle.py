@@ -137,7 +137,7 @@ class OraclePlanner:
         self._trace_graphs = context.trace_graphs
         self._graph: SceneGraph | None = None
         """The step's scene graph, built only for the trace (the oracle plans from the world)."""
-        self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)
+        self._body.start(sense_first=False)  # every trajectory starts with a full turn in place (paper S.3)
 
     def _adopt_next_option(self) -> bool:
         """Work on the best ground option not tried yet; False when every option has been tried."""

@@ -120,6 +120,24 @@ class Embodiment:
         components its path can drive back to)."""
         return self.builder.build(self.xy, self.trajectory)
 
+    def start(self, *, sense_first: bool = True) -> None:
+        """Begin an episode as every planner does: a frame where the robot stands (unless not
+        ``sense_first``), then the full turn in place (paper S.3)."""
+        if sense_first:
+            self.sense()
+        self.look_around()
+
+    def step_graph(self, label_rooms: Callable[[SceneGraph], dict[str, str]] | None = None) -> SceneGraph:
+        """The scene graph a step plans on: :meth:`build` without the frontiers explored before (so the
+        scene text and explore() agree), its unlabelled regions labelled by ``label_rooms`` (region id
+        -> room type; the builder keeps the labels for later steps)."""
+        graph = without_visited_frontiers(self.build(), self.visited_frontiers, self.config.visited_frontier_m)
+        labels = label_rooms(graph) if label_rooms is not None else {}
+        if labels:
+            self.builder.set_room_labels(labels)
+            graph = graph.with_room_labels(labels)
+        return graph
+
     def act(self, kind: str, target: str = "") -> ActionResult:
         """One magic action of the robot (a world action of the skill table: ``navigate_to``, ``grasp``,
         ..., ``done``) on ``target``, a label; the robot counts its motion."""
@@ -172,3 +190,16 @@ class Embodiment:
         """Sense once a magic action has moved the robot (its path is not empty)."""
         if result.path:
             self.sense()
+
+
+def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:
+    """The graph without frontiers near ones already explored, so the scene text and explore() agree."""
+    if not visited:
+        return graph
+    regions = {
+        rid: r.model_copy(
+            update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]}
+        )
+        for rid, r in graph.regions.items()
+    }
+    return graph.model_copy(update={"regions": regions})

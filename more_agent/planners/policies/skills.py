@@ -188,19 +188,6 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     )
 
 
-def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:
-    """The graph without frontiers near ones already explored, so the scene text and explore() agree."""
-    if not visited:
-        return graph
-    regions = {
-        rid: r.model_copy(
-            update={"frontiers": [f for f in r.frontiers if all(math.dist(f, v) > radius_m for v in visited)]}
-        )
-        for rid, r in graph.regions.items()
-    }
-    return graph.model_copy(update={"regions": regions})
-
-
 # -- dispatch through the skill table -----------------------------------------------------------
 
 
