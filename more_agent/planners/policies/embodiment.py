@@ -4,8 +4,10 @@ The robot steps the world only through the Gymnasium env (:class:`more_agent.sim
 built without sensors, goal or privileged info): every low-level action (7.5 cm forward moves, turns
 of at most 35 degrees) and every magic action is one ``env.step``, and is counted. Frames are
 rendered by the robot's own camera and fused into the
-:class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
-moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
+:class:`~more_agent.scene_graph.SceneGraphBuilder` wherever the robot stops (arrival, a blocked move,
+after acting, every turn of a look around) and, on the way, at the cadence of its mapper
+(:class:`~more_agent.planners.policies.sensing.SensingSchedule`: once it moved or turned far enough
+since the last frame), so the map grows while the robot drives.
 Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
 rests (inside / on top of what) are read from the world for the instances in view.
 """
@@ -19,6 +21,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
+from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
@@ -44,7 +47,9 @@ class PolicyConfig(BaseModel):
         gt=0,
         description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin).",
     )
-    sense_every_steps: int = Field(default=4, ge=1, description="Fuse a frame after this many forward moves on a path.")
+    sensing: SensingCadence = Field(
+        default_factory=SensingCadence, description="Distance or angle between frames fused on the way."
+    )
     max_replans: int = Field(
         default=3, ge=0, description="Replans on the updated map after a blocked move before giving up."
     )
@@ -95,6 +100,7 @@ class Embodiment:
         self.on_frame = on_frame
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
+        self.schedule = SensingSchedule(self.config.sensing)
 
     @property
     def xy(self) -> XY:
@@ -139,6 +145,12 @@ class Embodiment:
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
+        self.schedule.fused(*self.xy, self.world.robot.yaw)
+
+    def sense_if_due(self) -> None:
+        """Sense on the way: only when the schedule says the robot moved or turned far enough."""
+        if self.schedule.due(*self.xy, self.world.robot.yaw):
+            self.sense()
 
     def since_last_report(self, result: ActionResult) -> ActionResult:
         """``result`` with the low-level steps and path the robot made since the previous call (the first
@@ -196,20 +208,21 @@ class Embodiment:
         self._step("turn_left" if angle >= 0 else "turn_right", amount=abs(angle))
         self.low_level_steps += 1
 
-    def turn_by(self, angle: float) -> None:
-        """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense."""
+    def turn_by(self, angle: float, *, on_the_way: bool = False) -> None:
+        """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense (on the way:
+        when the schedule says so)."""
         angle = math.atan2(math.sin(angle), math.cos(angle))
         n = math.ceil(abs(angle) / MAX_TURN_RAD - 1e-9)
         for _ in range(n):
             self._turn(angle / n)
         if n:
-            self.sense()
+            self.sense_if_due() if on_the_way else self.sense()
 
-    def face(self, xy: Sequence[float]) -> None:
+    def face(self, xy: Sequence[float], *, on_the_way: bool = False) -> None:
         """Turn towards a point (no-op when standing on it)."""
         dx, dy = xy[0] - self.world.robot.x, xy[1] - self.world.robot.y
         if math.hypot(dx, dy) > 1e-6:
-            self.turn_by(math.atan2(dy, dx) - self.world.robot.yaw)
+            self.turn_by(math.atan2(dy, dx) - self.world.robot.yaw, on_the_way=on_the_way)
 
     def look_around(self) -> None:
         """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
@@ -219,9 +232,8 @@ class Embodiment:
 
     def follow(self, waypoints: Sequence[XY]) -> bool:
         """Drive along a polyline with low-level moves; False as soon as a move is blocked."""
-        moved = 0
         for target in waypoints[1:]:
-            self.face(target)
+            self.face(target, on_the_way=True)
             remaining = math.dist(self.xy, target)
             while remaining > 1e-6:
                 distance = min(FORWARD_STEP_M, remaining)
@@ -234,10 +246,8 @@ class Embodiment:
                     self.sense()
                     return False
                 remaining -= distance  # a move below the full step is made whole or not at all
-                moved += 1
                 self.trajectory.append(self.xy)
-                if moved % self.config.sense_every_steps == 0:
-                    self.sense()
+                self.sense_if_due()
         self.sense()
         return True
 
