@@ -41,4 +41,8 @@ def view(
     from more_agent.eval.viewer import write_viewer
 
     path = write_viewer(episode_dir, out)
-    err_console.print(f"wrote {path} (open it in a browser; left/right arrow keys move between steps)", highlight=False)
+    err_console.print(
+        f"wrote {path} (open it in a browser; left/right arrow keys move between steps)",
+        highlight=False,
+        soft_wrap=True,
+    )
