@@ -36,6 +36,7 @@ def view(
             f"wrote {rerun}: {summary.steps} steps, {summary.frames} frames, {summary.graphs} scene graphs "
             "(open it with: rerun FILE)",
             highlight=False,
+            soft_wrap=True,
         )
         return
     from more_agent.eval.viewer import write_viewer
