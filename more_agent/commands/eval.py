@@ -148,7 +148,7 @@ def eval_(
             highlight=False,
             markup=False,
         )
-    err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False)
+    err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False, soft_wrap=True)
     status = episodes_exit_status(records)
     if status == EXIT_FAILED:
         err_console.print(

@@ -50,4 +50,4 @@ def report(
         err_console.print(f"[yellow]{dropped} duplicate episode(s) dropped (the first run listed wins)[/]")
     if out is not None:
         paths = write_reports(sourced, out, title="Comparison of " + ", ".join(str(d) for d in run_dirs))
-        err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False)
+        err_console.print("wrote " + ", ".join(str(p) for p in paths), highlight=False, markup=False, soft_wrap=True)

@@ -124,7 +124,7 @@ def generate(
 
     check_output_file(out)
     save_scene(get_scene(scene, seed), out)
-    console.print(f"wrote {out}", highlight=False, markup=False)
+    console.print(f"wrote {out}", highlight=False, markup=False, soft_wrap=True)  # a path is never broken
 
 
 @app.command("render")
@@ -145,4 +145,4 @@ def render(
     path = out if out.suffix else out.with_suffix(".png")
     check_output_file(path)
     written = plot_plan(get_scene(scene, seed), path, label_furniture=labels)
-    console.print(f"wrote {written}", highlight=False, markup=False)
+    console.print(f"wrote {written}", highlight=False, markup=False, soft_wrap=True)

@@ -36,9 +36,14 @@ def view(
             f"wrote {rerun}: {summary.steps} steps, {summary.frames} frames, {summary.graphs} scene graphs "
             "(open it with: rerun FILE)",
             highlight=False,
+            soft_wrap=True,
         )
         return
     from more_agent.eval.viewer import write_viewer
 
     path = write_viewer(episode_dir, out)
-    err_console.print(f"wrote {path} (open it in a browser; left/right arrow keys move between steps)", highlight=False)
+    err_console.print(
+        f"wrote {path} (open it in a browser; left/right arrow keys move between steps)",
+        highlight=False,
+        soft_wrap=True,
+    )

@@ -133,9 +133,9 @@ class SceneGraphBuilder:
         """Update which instances ride on the held one (perception says what each rests on / in). Newly
         carried ones leave the voxel map like the held one (seen in the robot's hand, they would map as
         an obstacle where the robot stands) and are kept in the graph, travelling with the robot."""
-        by_label = {info.label: iid for iid, info in self._instances.items()}
-        carried = set()
+        carried: set[int] = set()
         holding = any(info.held for info in self._instances.values())
+        by_label = {info.label: iid for iid, info in self._instances.items()} if holding else {}
         for iid, info in self._instances.items() if holding else ():
             chain = info
             for _ in range(len(by_label)):  # up the supports, as far as the held object (cycles end it)
@@ -226,10 +226,14 @@ class SceneGraphBuilder:
         inside = np.einsum("ij,ij->i", cam, cam) <= self.config.max_range_m**2
         pts = cam[inside] @ T_world_cam[:3, :3].T + T_world_cam[:3, 3]
         ids = instance[v, u][inside]
+        if ids.size == 0:
+            return
+        order = np.argsort(ids, kind="stable")
+        ids, pts = ids[order], pts[order]
+        starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])  # one run of points per instance
         half = self.config.resolution_m / 2
-        for iid in np.unique(ids).tolist():
-            mine = pts[ids == iid]
-            self._glimpsed[iid] = (mine.min(0) - half, mine.max(0) + half)
+        lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
+        self._glimpsed.update(zip(ids[starts].tolist(), zip(lows, highs, strict=True), strict=True))
 
     def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
         half = self.config.resolution_m / 2

@@ -37,17 +37,20 @@ def test_observed_objects_match_goal_condition_names_so_rtp_counts_them() -> Non
 
 
 def test_record_says_how_hard_the_world_was() -> None:
-    record = run_episode(SPEC)
+    # The stats describe the world the runner built, whatever the planner then does: it calls done() at once.
+    record = run_episode(SPEC, planner=_DoneAtOnce())
     stats = record.world_stats
+    assert record.done_called and record.high_level_steps == 1
     assert stats is not None and stats.task_objects >= 5 and stats.objects > stats.task_objects
     assert stats.start_room and stats.task_rooms and stats.start_to_task_m is not None and stats.start_to_task_m >= 0
-    task_room = run_episode(SPEC.model_copy(update={"start": "task-room"})).world_stats
+    task_room = run_episode(SPEC.model_copy(update={"start": "task-room"}), planner=_DoneAtOnce()).world_stats
     assert task_room is not None and task_room.start_room in task_room.task_rooms
-    store = run_episode(EpisodeSpec(task="bag_groceries", scene="grocery_store_asian", seed=0, planner="oracle"))
+    store_spec = EpisodeSpec(task="bag_groceries", scene="grocery_store_asian", seed=0, planner="oracle")
+    store = run_episode(store_spec, planner=_DoneAtOnce())
     assert store.world_stats is not None and store.world_stats.objects >= 500 and store.world_stats.distractors >= 400
     bare_spec = config_specs(RunConfig(planner="oracle", tasks=["bag_groceries"], seeds=[0], scene="grocery_store_asian",
                                        episode_fn="x:y", distractors=False))[0]
-    bare = run_episode(bare_spec).world_stats  # --no-distractors: the worlds before the scenes' own objects came in
+    bare = run_episode(bare_spec, planner=_DoneAtOnce()).world_stats  # --no-distractors: the worlds before the scenes' own objects
     assert bare is not None and bare.distractors == 0 and bare.objects <= store.world_stats.objects - 400
 
 
@@ -78,6 +81,13 @@ class _Idle:
 
     def llm_usage(self) -> LLMUsage:
         return LLMUsage()
+
+
+class _DoneAtOnce(_Idle):
+    """A planner that calls done() at its first step."""
+
+    def decide(self) -> HighLevelAction:
+        return HighLevelAction("done")
 
 
 def test_step_limit_ends_the_episode_with_the_reason() -> None:

@@ -40,27 +40,49 @@ def camera_pose(x: float, y: float, yaw: float, *, height: float = 1.3, pitch_de
 
 
 def render(boxes: list[Box], K: np.ndarray, T: np.ndarray, size: int, max_range: float = 5.0):
-    """(depth, semantic, instance) of the boxes seen from pose T."""
+    """(depth, semantic, instance) of the boxes seen from pose T: slab tests one box at a time over the
+    pixels its corners project to (all of them when a corner is behind the camera), the nearest hit
+    kept (the first box on ties)."""
     v, u = np.mgrid[0:size, 0:size]
     cam = np.stack([(u + 0.5 - K[0, 2]) / K[0, 0], (v + 0.5 - K[1, 2]) / K[1, 1], np.ones((size, size))], -1).reshape(-1, 3)
     dirs = cam @ T[:3, :3].T
     o = T[:3, 3]
-    lo = np.array([b.lo for b in boxes])
-    hi = np.array([b.hi for b in boxes])
+    tz = np.full(len(dirs), np.inf)
+    best = np.zeros(len(dirs), dtype=np.intp)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t1 = (lo[None] - o) / dirs[:, None, :]
-        t2 = (hi[None] - o) / dirs[:, None, :]
-    tn = np.nanmax(np.minimum(t1, t2), axis=2)
-    tf = np.nanmin(np.maximum(t1, t2), axis=2)
-    hit = (tn <= tf) & (tf > 0)
-    t = np.where(hit, np.maximum(tn, 0), np.inf)
-    best = np.argmin(t, axis=1)
-    tz = t[np.arange(len(t)), best]  # along cam, whose z component is 1: tz is z-depth
-    ok = np.isfinite(tz) & (tz * np.linalg.norm(cam, axis=1) <= max_range)
+        inv = 1.0 / dirs
+        for i, b in enumerate(boxes):
+            pix = _pixels_of(b, K, T, size)
+            if pix is not None and len(pix) == 0:
+                continue
+            lo, hi = np.subtract(b.lo, o), np.subtract(b.hi, o)
+            d = inv if pix is None else inv[pix]
+            t1, t2 = lo * d, hi * d
+            tn = np.fmax.reduce(np.minimum(t1, t2), axis=1)  # fmax / fmin skip the NaN of 0 * inf, like nanmax
+            tf = np.fmin.reduce(np.maximum(t1, t2), axis=1)
+            t = np.where((tn <= tf) & (tf > 0), np.maximum(tn, 0), np.inf)
+            idx = np.arange(len(dirs)) if pix is None else pix
+            closer = t < tz[idx]
+            tz[idx[closer]], best[idx[closer]] = t[closer], i
+    ok = np.isfinite(tz) & (tz * np.linalg.norm(cam, axis=1) <= max_range)  # along cam, whose z is 1: tz is z-depth
     depth = np.where(ok, tz, np.nan).astype(np.float32).reshape(size, size)
     sem = np.where(ok, np.array([CID[b.cls] for b in boxes])[best], 0).astype(np.int32).reshape(size, size)
     inst = np.where(ok, np.array([b.instance for b in boxes])[best], 0).astype(np.int32).reshape(size, size)
     return depth, sem, inst
+
+
+def _pixels_of(box: Box, K: np.ndarray, T: np.ndarray, size: int) -> np.ndarray | None:
+    """Flat indices of the pixels inside the image rectangle around the box's projected corners (one
+    pixel of margin); None when a corner lies at or behind the camera plane (test every pixel)."""
+    corners = np.array([[x, y, z] for x in (box.lo[0], box.hi[0]) for y in (box.lo[1], box.hi[1]) for z in (box.lo[2], box.hi[2])])
+    c = (corners - T[:3, 3]) @ T[:3, :3]
+    if (c[:, 2] <= 1e-6).any():
+        return None
+    uv = (c[:, :2] / c[:, 2:]) * [K[0, 0], K[1, 1]] + [K[0, 2], K[1, 2]]
+    u0, v0 = np.clip(np.floor(uv.min(0)).astype(int) - 1, 0, size)
+    u1, v1 = np.clip(np.ceil(uv.max(0)).astype(int) + 1, 0, size)
+    v, u = np.mgrid[v0:v1, u0:u1]
+    return (v * size + u).ravel()
 
 
 def walls_x(x: float, y0: float, y1: float, *, openings=(), thick: float = 0.15, height: float = 2.6) -> list[Box]:

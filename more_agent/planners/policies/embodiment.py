@@ -3,9 +3,10 @@ its frames feed, and what the subpolicies remember of where it went.
 
 Every low-level action (7.5 cm forward moves, turns of at most 35 degrees) and every magic action is
 one call of the robot (the simulator's steps its Gymnasium env), which counts it. Frames are sensed
-by the robot and fused into the :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn
-sequence and every few forward moves on the way (``PolicyConfig.sense_every_steps``), so the map
-grows while the robot drives. Nothing here reads the world: what perception reports comes with each
+by the robot and fused into the :class:`~more_agent.scene_graph.SceneGraphBuilder` wherever the robot
+stops (arrival, a blocked move, after acting, every turn of a look around) and, on the way, at the
+cadence of its mapper (:class:`~more_agent.planners.policies.sensing.SensingSchedule`: once it moved
+or turned far enough since the last frame), so the map grows while the robot drives. Nothing here reads the world: what perception reports comes with each
 :class:`~more_agent.robot.Observation`.
 """
 
@@ -18,6 +19,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
+from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.robot import XY, ActionResult, Frame, Robot
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT, full_turn_angles
 from more_agent.scene_graph import SceneGraph, SceneGraphBuilder
@@ -37,7 +39,9 @@ class PolicyConfig(BaseModel):
         gt=0,
         description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin).",
     )
-    sense_every_steps: int = Field(default=4, ge=1, description="Fuse a frame after this many forward moves on a path.")
+    sensing: SensingCadence = Field(
+        default_factory=SensingCadence, description="Distance or angle between frames fused on the way."
+    )
     max_replans: int = Field(
         default=3, ge=0, description="Replans on the updated map after a blocked move before giving up."
     )
@@ -80,6 +84,7 @@ class Embodiment:
         """Called with every sensed frame (BUMBLE keeps them in its visual memory)."""
         self.observed: set[int] = set()
         """Instance ids seen so far, in view or in the hand (a planner tells from it whether a skill revealed anything)."""
+        self.schedule = SensingSchedule(self.config.sensing)
 
     @property
     def xy(self) -> XY:
@@ -114,6 +119,12 @@ class Embodiment:
         if self.robot.held is not None:
             self.observed.add(self.robot.held)
         self.observed.discard(0)
+        self.schedule.fused(*self.robot.pose)
+
+    def sense_if_due(self) -> None:
+        """Sense on the way: only when the schedule says the robot moved or turned far enough."""
+        if self.schedule.due(*self.robot.pose):
+            self.sense()
 
     def build(self) -> SceneGraph:
         """The scene graph of everything sensed so far, from the robot's position (joined with the
@@ -143,21 +154,22 @@ class Embodiment:
         ..., ``done``) on ``target``, a label; the robot counts its motion."""
         return self.robot.act(kind, target)
 
-    def turn_by(self, angle: float) -> None:
-        """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense."""
+    def turn_by(self, angle: float, *, on_the_way: bool = False) -> None:
+        """Turn in place by ``angle`` radians in steps of at most 35 degrees, then sense (on the way:
+        when the schedule says so)."""
         angle = math.atan2(math.sin(angle), math.cos(angle))
         n = math.ceil(abs(angle) / MAX_TURN_RAD - 1e-9)
         for _ in range(n):
             self.robot.turn(angle / n)
         if n:
-            self.sense()
+            self.sense_if_due() if on_the_way else self.sense()
 
-    def face(self, xy: Sequence[float]) -> None:
+    def face(self, xy: Sequence[float], *, on_the_way: bool = False) -> None:
         """Turn towards a point (no-op when standing on it)."""
         x, y, yaw = self.robot.pose
         dx, dy = xy[0] - x, xy[1] - y
         if math.hypot(dx, dy) > 1e-6:
-            self.turn_by(math.atan2(dy, dx) - yaw)
+            self.turn_by(math.atan2(dy, dx) - yaw, on_the_way=on_the_way)
 
     def look_around(self) -> None:
         """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
@@ -167,9 +179,8 @@ class Embodiment:
 
     def follow(self, waypoints: Sequence[XY]) -> bool:
         """Drive along a polyline with low-level moves; False as soon as a move is blocked."""
-        moved = 0
         for target in waypoints[1:]:
-            self.face(target)
+            self.face(target, on_the_way=True)
             remaining = math.dist(self.xy, target)
             while remaining > 1e-6:
                 distance = min(FORWARD_STEP_M, remaining)
@@ -180,9 +191,7 @@ class Embodiment:
                     self.sense()
                     return False
                 remaining -= distance  # a move below the full step is made whole or not at all
-                moved += 1
-                if moved % self.config.sense_every_steps == 0:
-                    self.sense()
+                self.sense_if_due()
         self.sense()
         return True
 

@@ -1,0 +1,48 @@
+"""The sensing schedule: frames on the way come at a fixed distance or angle, frames where the robot stops always."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from more_agent.planners.policies import Embodiment
+from more_agent.planners.policies.embodiment import PolicyConfig
+from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
+from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.scene import load_scene
+
+KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
+
+
+def test_a_frame_is_due_after_the_distance_or_the_angle_not_before() -> None:
+    schedule = SensingSchedule(SensingCadence(distance_m=0.6, angle_deg=30))
+    assert schedule.due(0.0, 0.0, 0.0)  # nothing fused yet
+    schedule.fused(0.0, 0.0, 0.0)
+    assert not schedule.due(0.59, 0.0, 0.0) and schedule.due(0.6, 0.0, 0.0) and schedule.due(0.3, 0.55, 0.0)
+    assert not schedule.due(0.0, 0.0, math.radians(29)) and schedule.due(0.0, 0.0, math.radians(30))
+    schedule.fused(0.0, 0.0, math.radians(179))
+    assert not schedule.due(0.0, 0.0, math.radians(-179))  # 2 deg across the wrap
+
+
+def test_the_angle_stays_below_the_cameras_field_of_view() -> None:
+    with pytest.raises(ValueError):
+        SensingCadence(angle_deg=63.3)
+
+
+@pytest.mark.parametrize("distance_m", [0.3, 0.6])
+def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_m: float) -> None:
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
+    body = Embodiment(inst.world, config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
+    body.sense()  # the frame where the robot stands
+    frames: list[tuple[float, float]] = []
+    body.on_frame = lambda frame: frames.append(body.xy)
+    start = body.xy
+    yaw = body.world.robot.yaw
+    goal = (start[0] + 1.5 * math.cos(yaw), start[1] + 1.5 * math.sin(yaw))  # straight ahead: no turn on the way
+    assert body.follow([start, goal])
+    gaps = [math.dist(a, b) for a, b in zip([start, *frames], frames, strict=False)]
+    assert frames[-1] == body.xy == pytest.approx(goal)  # the arrival is always sensed
+    assert all(g <= distance_m + 1e-6 for g in gaps), gaps  # never further apart than the cadence
+    assert len(frames) == math.floor(1.5 / distance_m + 1e-6) + 1  # one per distance on the way, one at arrival
