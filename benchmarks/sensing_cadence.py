@@ -62,7 +62,7 @@ class Shadowed:
             shadowed._attach(body)
 
         def sense_if_due(body: Any) -> None:
-            pose = (*body.xy, body.world.robot.yaw)
+            pose = body.robot.pose
             if body.schedule.due(*pose):
                 body.shadow_take = body.shadow_schedule.due(*pose)
                 body.sense()
@@ -79,7 +79,7 @@ class Shadowed:
     def _attach(self, body: Any) -> None:
         body.schedule = SensingSchedule(self.reference)
         body.shadow_schedule = SensingSchedule(self.candidate)
-        body.shadow = SceneGraphBuilder(body.world.class_names, body.builder.config)
+        body.shadow = SceneGraphBuilder(body.robot.class_names, body.builder.config)
         body.shadow_take, body.shadow_frames, body.frames = True, 0, 0
         integrate, remember = body.builder.integrate, body.builder.remember
 
@@ -89,7 +89,7 @@ class Shadowed:
             if body.shadow_take:
                 body.shadow.integrate(*args)
                 body.shadow_frames += 1
-                body.shadow_schedule.fused(*body.xy, body.world.robot.yaw)
+                body.shadow_schedule.fused(*body.robot.pose)
 
         def both_remember(*args: Any) -> None:
             remember(*args)
