@@ -134,9 +134,10 @@ def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_ope
     body = Embodiment(world)
     body.look_around()
     bag = world.get("sack_1").label
-    fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))
     _act(body, "open", "door_0")
     _act(body, "grasp", "sack_1")
+    fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))  # labelled when first seen
+    assert len(fruit) == 4 and all(fruit), f"the robot looked down into the bag it grasped and saw all of {fruit}"
     graph = body.build()
     view = scene_view(graph, LanguageOptions())
     robot_room = view.room(view.robot_room)

@@ -22,7 +22,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
-from more_agent.sim.camera import Camera
+from more_agent.sim.camera import camera_pose
 from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
 from more_agent.sim.motion import full_turn_angles
 from more_agent.sim.navgrid import XY
@@ -32,6 +32,11 @@ from more_agent.vocabulary import Relation
 
 PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
+
+
+LOOK_AROUND_TILT_DEG = 55.0
+"""Head tilt of the downward looks in a full turn: with the Fetch's 63.3 deg view the image then spans 23 to
+87 deg below the horizon, the floor from right beside the base to 2.8 m out (``Embodiment.look_around``)."""
 
 
 class PolicyConfig(BaseModel):
@@ -57,10 +62,12 @@ class PolicyConfig(BaseModel):
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
     blind_radius_m: float = Field(
-        default_factory=lambda: Camera().blind_floor_m,
+        default=ROBOT.radius_m + PLAN_MARGIN_M,
         ge=0,
-        description="Unknown cells this close to where the robot has been count as free on its map: the camera "
-        "never sees the floor this close to the robot (``Camera.blind_floor_m``: 0.56 m at 90 deg, 0.95 m at the Fetch's 63.3 deg).",
+        description="Unknown cells this close to where the robot has been count as free on its map: the floor under "
+        "and beside the base, which the head's downward looks (``look_around``, after a magic action's approach) "
+        "do not show on a real robot. The driving pitch alone never shows the floor within ``Camera.blind_floor_m`` "
+        "(0.95 m at the Fetch's 63.3 deg).",
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
@@ -101,16 +108,22 @@ class Embodiment:
         """Robot base position."""
         return (float(self.world.robot.x), float(self.world.robot.y))
 
-    def sense(self, acted_on: Sequence[str] = ()) -> None:
+    def sense(self, acted_on: Sequence[str] = (), head: tuple[float, float] | None = None) -> None:
         """Render a frame from the current pose and fuse it into the scene-graph builder.
 
         The robot knows what it did: an item released since the last frame is reported as no longer
         held, resting where it was put, even when no camera sees it (the builder keeps it, and what
         rode on or in it, at their boxes until a frame shows them), and the objects in ``acted_on``
         (world names: what it just opened or closed) are reported with their new state even when out
-        of view.
+        of view. ``head`` (pan left, tilt down; radians) points the head away from its driving pose
+        (:meth:`look_down_at`).
         """
-        frame = self.renderer.render(self.world)
+        r = self.world.robot
+        if head is None:
+            frame = self.renderer.render(self.world)
+        else:
+            pose = camera_pose(r.x, r.y, r.yaw + head[0], height_m=self.renderer.camera.height_m, pitch_rad=head[1])
+            frame = self.renderer.render_at(self.world, pose)
         if self.on_frame is not None:
             self.on_frame(frame)
         table = instance_table(self.world, frame.instance)
@@ -139,6 +152,25 @@ class Embodiment:
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(d["name"] for d in table.values())
+
+    def look_down_at(self, xy: Sequence[float], acted_on: Sequence[str] = ()) -> None:
+        """Pan and tilt the head to the floor at ``xy`` and sense (the base turns only when ``xy`` lies beyond
+        the head's pan limit; head motions are no base steps and are not counted): the driving pitch leaves
+        the floor within ``Camera.blind_floor_m``, and what lies low in a bag or on a table beside the robot,
+        below the image. Aiming at the floor under an object puts its top and inside in view; through a
+        doorway, the floor of the next room."""
+        r, cam = self.world.robot, self.renderer.camera
+        dx, dy = xy[0] - r.x, xy[1] - r.y
+        pan = math.atan2(dy, dx) - r.yaw if math.hypot(dx, dy) > 1e-6 else 0.0
+        pan = math.atan2(math.sin(pan), math.cos(pan))
+        if abs(pan) > math.radians(ROBOT.camera.head_pan_limit_deg):  # behind the head's reach: turn the base
+            self.face(xy)
+            pan = 0.0
+        tilt = min(
+            max(math.atan2(cam.height_m, math.hypot(dx, dy)), math.radians(cam.pitch_deg)),
+            math.radians(ROBOT.camera.head_tilt_limit_deg),
+        )
+        self.sense(acted_on, head=(pan, tilt))
 
     def since_last_report(self, result: ActionResult) -> ActionResult:
         """``result`` with the low-level steps and path the robot made since the previous call (the first
@@ -212,10 +244,15 @@ class Embodiment:
             self.turn_by(math.atan2(dy, dx) - self.world.robot.yaw)
 
     def look_around(self) -> None:
-        """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
-        for angle in full_turn_angles():
+        """A full turn in place, sensing after every turn (episode start, reached frontiers), with the head
+        also tilted down after every other turn (``LOOK_AROUND_TILT_DEG``): the driving pitch never shows the
+        floor within ``Camera.blind_floor_m``, which would leave the robot standing in a hole of unknown
+        space that cuts it off from the map around it."""
+        for i, angle in enumerate(full_turn_angles()):
             self._turn(angle)
             self.sense()
+            if i % 2 == 0:
+                self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))
 
     def follow(self, waypoints: Sequence[XY]) -> bool:
         """Drive along a polyline with low-level moves; False as soon as a move is blocked."""
@@ -231,7 +268,7 @@ class Embodiment:
                     reach = FORWARD_STEP_M + ROBOT.radius_m
                     yaw = self.world.robot.yaw
                     self.bumps.append((self.xy[0] + reach * math.cos(yaw), self.xy[1] + reach * math.sin(yaw)))
-                    self.sense()
+                    self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))  # down at what the move met
                     return False
                 remaining -= distance  # a move below the full step is made whole or not at all
                 moved += 1
@@ -242,10 +279,12 @@ class Embodiment:
         return True
 
     def record_jump(self, path: Sequence[XY], steps: int) -> None:
-        """Account for a motion a magic action made (its path and low-level steps), then sense."""
+        """Account for a motion a magic action made (its path and low-level steps), then sense, also with the
+        head down: the approach ends where the robot may never have seen the floor."""
         self.add_motion(path, steps)
         if path:
             self.sense()
+            self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))
 
     def add_motion(self, path: Sequence[XY], steps: int) -> None:
         """Count a motion made by a magic action (its path, start included, and low-level steps) without sensing."""
