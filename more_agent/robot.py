@@ -121,9 +121,11 @@ class Robot(Protocol):
     def low_level_steps(self) -> int:
         """Low-level steps (moves, turns, the steps of magic actions) since the episode began."""
 
-    def sense(self, acted_on: Sequence[str] = ()) -> Observation:
+    def sense(self, acted_on: Sequence[str] = (), head: tuple[float, float] | None = None) -> Observation:
         """A frame from the current pose with what perception says of it; ``acted_on`` (labels: what the
-        robot just opened or closed) are reported with their new state even when out of view."""
+        robot just opened or closed) are reported with their new state even when out of view; ``head``
+        (pan left, tilt down, radians; within the head's joint limits) points the camera away from its
+        driving pose for this frame (None: the driving pose)."""
 
     def move_forward(self, distance: float) -> bool:
         """One low-level move of at most ``FORWARD_STEP_M``; False when blocked (the robot does not move)."""

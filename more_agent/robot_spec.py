@@ -32,22 +32,26 @@ class CameraSpec:
 
     The field of view is the paper's Fetch in OmniGibson: its ``VisionSensor`` sets a 17 mm focal length
     and keeps USD's default 20.955 mm horizontal aperture, 2 atan(20.955 / 34) = 63.3 degrees
-    (:data:`OMNIGIBSON_FETCH_HFOV_DEG`). The default is still 90 degrees: with 63.3 the loop loses
-    episodes through defects the narrower view exposes (docs/sensors.md), so the alignment waits on
-    them. With 90 degrees the ground is visible from 0.56 m in front of the robot and a 2.1 m door
-    lintel from 1.9 m away (0.95 m and 4.4 m with 63.3).
+    (:data:`OMNIGIBSON_FETCH_HFOV_DEG`). At the default pitch the ground is visible from 0.95 m in front of
+    the robot and a 2.1 m door lintel from 4.4 m away (0.56 m and 1.9 m with the 90 degrees used before).
+    The head pans and tilts (``head_pan_limit_deg``, ``head_tilt_limit_deg``): the robot looks down at
+    what it is about to act on (``Embodiment.look_down_at``), which the fixed pitch leaves below the image.
     """
 
     image_size: int = 256
     """Width and height of every frame in pixels (paper S.2)."""
-    hfov_deg: float = 90.0
-    """Horizontal field of view in degrees (square pixels: the vertical one is the same)."""
+    hfov_deg: float = OMNIGIBSON_FETCH_HFOV_DEG
+    """Horizontal field of view in degrees (square pixels: the vertical one is the same): OmniGibson's Fetch."""
     pitch_deg: float = 20.0
-    """Fixed downward tilt of the optical axis below the horizon, in degrees."""
+    """Downward tilt of the optical axis below the horizon, in degrees, while the robot drives and looks around."""
     height_m: float = 1.2
     """Height of the optical centre above the ground (the Fetch head camera with the torso lowered)."""
     max_range_m: float = 5.0
     """Sensor range: pixels whose z-depth exceeds it are invalid (paper S.2)."""
+    head_pan_limit_deg: float = 90.0
+    """How far the head pans left or right of the base's heading (the Fetch's ``head_pan_joint``: +-1.57 rad)."""
+    head_tilt_limit_deg: float = 83.0
+    """How far down the head tilts below the horizon (the Fetch's ``head_tilt_joint``: 1.45 rad)."""
 
 
 @dataclass(frozen=True)

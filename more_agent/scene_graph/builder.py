@@ -19,11 +19,22 @@ labels one graph only).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from more_agent.mapping import OCCUPIED, MappingConfig, NavGraph, RegionGraph, VoxelMap, line_of_sight, region_graph
+from more_agent.mapping import (
+    FREE,
+    OCCUPIED,
+    MappingConfig,
+    NavGraph,
+    RegionGraph,
+    VoxelMap,
+    line_of_sight,
+    region_graph,
+)
 from more_agent.robot import InstanceInfo
 from more_agent.scene_graph.model import (
     Box3D,
@@ -203,9 +214,15 @@ class SceneGraphBuilder:
             config=self.config,
         )
         region_ids = self._stable_ids(rg.graph, rg.labels)
-        keep = self._robot_component(rg.graph, robot, blocked, grid, self._retraceable(path_xy, occ, grid))
+        path = _densified(self._retraceable(path_xy, occ, grid), grid.resolution_m)
+        keep = self._robot_component(rg.graph, robot, blocked, grid, path)
         frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
-        return self._assemble(rg, region_ids, keep, objects, frontier_node, robot, occ, grid)
+        frontier_node = self._through_openings(rg.graph, rg.labels, keep, rg.frontier_xy, frontier_node, occ, grid)
+        is_door = np.array([self._instances[i].category == "door" for i in objects], dtype=bool)
+        assigned = self._doors_to_reach(rg.graph, rg.labels, keep, centres[:, :2], rg.assigned, is_door)
+        return self._assemble(
+            replace(rg, assigned=assigned), region_ids, keep, objects, frontier_node, robot, occ, grid
+        )
 
     # ---------------------------------------------------------------- helpers
     def _glimpse(
@@ -285,6 +302,47 @@ class SceneGraphBuilder:
         """Node index (labelled nodes only, -1 if none) each point belongs to."""
         labelled = np.flatnonzero(labels >= 0)
         return np.array([self._nearest_visible(graph, labelled, p, blocked, grid) for p in points], dtype=np.int64)
+
+    @staticmethod
+    def _through_openings(
+        graph: NavGraph, labels: np.ndarray, keep: np.ndarray, points: np.ndarray, node: np.ndarray, occ, grid: Grid
+    ) -> np.ndarray:
+        """Frontier attachments moved into the robot's component where the free space they border runs
+        into it: the part of a room seen through a narrow opening (a door ajar, a doorway glimpsed from
+        the side) is a strip too thin for the graph, so its frontier would hang on a region out of reach,
+        and the room it leads to would offer none. It goes to the nearest node of the robot's component in
+        the same patch of seen-free space: explore() drives through the opening to it."""
+        out = {i for i, n in enumerate(node.tolist()) if n < 0 or not keep[n]}
+        reachable = np.flatnonzero(keep & (labels >= 0))
+        if not out or reachable.size == 0:
+            return node
+        patches, _ = ndimage.label(occ == FREE, structure=np.ones((3, 3), dtype=bool))
+        node_patch = _patch_at(patches, grid, graph.xy[reachable])
+        point_patch = _patch_at(patches, grid, points)
+        node = node.copy()
+        for i in sorted(out):
+            mine = reachable[(node_patch == point_patch[i]) & (point_patch[i] > 0)]
+            if mine.size:
+                node[i] = mine[np.argmin(np.linalg.norm(graph.xy[mine] - points[i], axis=1))]
+        return node
+
+    @staticmethod
+    def _doors_to_reach(
+        graph: NavGraph, labels: np.ndarray, keep: np.ndarray, xy: np.ndarray, assigned: np.ndarray, doors: np.ndarray
+    ) -> np.ndarray:
+        """Region labels with every door whose region is out of reach given the nearest region within reach
+        instead: a door joins two rooms, and once opened its leaf no longer separates them, so Eq. 1 may
+        give it to the room behind, which the robot has not reached; the robot that opened it still sees it
+        from its own side."""
+        kept_labels = np.unique(labels[keep & (labels >= 0)])
+        reachable = np.flatnonzero(keep & (labels >= 0))
+        lost = np.flatnonzero(doors & ~np.isin(assigned, kept_labels))
+        if lost.size == 0 or reachable.size == 0:
+            return assigned
+        assigned = assigned.copy()
+        for i in lost.tolist():
+            assigned[i] = labels[reachable[np.argmin(np.linalg.norm(graph.xy[reachable] - xy[i], axis=1))]]
+        return assigned
 
     def _stable_ids(self, graph: NavGraph, labels: np.ndarray) -> list[str]:
         """Region id per label, inheriting ids through remembered anchors (see module docstring)."""
@@ -419,3 +477,23 @@ class SceneGraphBuilder:
             open=info.open,
             held=info.held,
         )
+
+
+def _patch_at(patches: np.ndarray, grid: Grid, points: np.ndarray) -> np.ndarray:
+    """The label in ``patches`` (0: none) of the cell under each point (n x 2); 0 off the grid."""
+    cells = grid.cell_of(np.asarray(points, dtype=float).reshape(-1, 2))
+    on = ((cells >= 0) & (cells < patches.shape)).all(axis=1)
+    out = np.zeros(len(cells), dtype=patches.dtype)
+    out[on] = patches[cells[on, 0], cells[on, 1]]
+    return out
+
+
+def _densified(path: np.ndarray, spacing_m: float) -> np.ndarray:
+    """The polyline ``path`` (n x 2) with points added every ``spacing_m`` or less between its vertices: a
+    magic action's approach adds waypoints metres apart, and the robot passed every point between them."""
+    if len(path) < 2:
+        return path
+    steps = np.diff(path, axis=0)
+    counts = np.ceil(np.abs(steps).max(axis=1) / spacing_m).astype(int)
+    between = [path[i] + steps[i] * (np.arange(1, n)[:, None] / n) for i, n in enumerate(counts) if n > 1]
+    return np.concatenate([path, *between]) if between else path

@@ -69,6 +69,12 @@ def _names_instance(world: World, name: str) -> bool:
     return obj is not None and (obj.kind != "floor" or obj.room is not None)
 
 
+def _names_room(text: str, room_type: str) -> bool:
+    """Whether ``text`` names rooms of ``room_type`` ('living_room': "living room" or "living_room")."""
+    words = text.lower()
+    return room_type.lower() in words or room_type.lower().replace("_", " ") in words
+
+
 def scope_categories(scope: str) -> frozenset[str]:
     """Object categories that count as a scope's synset: the synset's own and its descendants' (and
     the synset's lemma, for synsets the taxonomy lacks)."""
@@ -78,15 +84,21 @@ def scope_categories(scope: str) -> frozenset[str]:
 
 def ambiguous_scopes(instance: DescribedTask) -> list[str]:
     """The goal scopes the instance's description cannot single out (module docstring), sorted."""
-    return ambiguous_in(instance.world, instance.definition, instance.scope, described_scopes(instance))
+    return ambiguous_in(
+        instance.world, instance.definition, instance.scope, described_scopes(instance), instance.description_template
+    )
 
 
-def ambiguous_in(world: World, definition: TaskDefinition, scope: Mapping[str, str], described: set[str]) -> list[str]:
+def ambiguous_in(
+    world: World, definition: TaskDefinition, scope: Mapping[str, str], described: set[str], text: str = ""
+) -> list[str]:
     """The goal scopes of ``definition`` bound to world objects (``scope``: scope -> world name) that
     ``described`` leaves out and that the world's other objects make ambiguous, sorted.
 
     A group (:func:`scope_groups`) is ambiguous when an object outside it has one of its categories:
-    in a room of its ``inroom`` type, for furniture; movable, for a group the goal moves (a reader
+    for furniture, in a room of its ``inroom`` type when the description ``text`` names that type ("the
+    shelf" alone fits a bookcase of any room; "the shelf in the living room" only the living room's), in any
+    room otherwise; movable, for a group the goal moves (a reader
     knows furniture stays put). A ``forall`` over furniture the goal does not move ("close every
     cabinet") is addressed by acting on them all, so it never is; nor is an ``exists`` one of whose
     range the description names (the reader acts on that one).
@@ -110,7 +122,7 @@ def ambiguous_in(world: World, definition: TaskDefinition, scope: Mapping[str, s
             continue
         own = {scope[s] for s in members}
         categories = scope_categories(members[0])
-        rooms = {room_of[s] for s in members if s in room_of}
+        rooms = {room_of[s] for s in members if s in room_of and _names_room(text, room_of[s])}
         if any(
             o.name not in own
             and o.category in categories

@@ -7,9 +7,10 @@ camera coordinates to world coordinates. Pixel (u, v) has its centre at integer 
 symmetric image is ((W - 1) / 2, (H - 1) / 2).
 
 Geometry (see docs/sensors.md for the reasons) is the robot's, :attr:`more_agent.robot_spec.RobotSpec.camera`:
-256 x 256 pixels, 90 degrees horizontal field of view (OmniGibson's Fetch has 63.3: see ``CameraSpec``) with
+256 x 256 pixels, 63.3 degrees horizontal field of view (OmniGibson's Fetch: see ``CameraSpec``) with
 square pixels (so the same vertically), mounted 1.2 m above the ground (the Fetch head camera
-with the torso lowered) and pitched 20 degrees down, 5 m range. The constants below name those values
+with the torso lowered) and pitched 20 degrees down while driving (the head pans and tilts: ``camera_pose``
+takes any pitch), 5 m range. The constants below name those values
 for this module's callers.
 """
 
@@ -57,7 +58,7 @@ class Camera:
     @property
     def blind_floor_m(self) -> float:
         """Distance from the camera's foot within which the floor lies below the image's bottom edge:
-        the robot never sees the floor this close to it (0.56 m with the default geometry, 0.95 m at 63.3 deg)."""
+        the robot never sees the floor this close to it at this pitch (0.95 m with the default geometry, 0.56 m at 90 deg)."""
         half_vfov = math.atan((self.height / 2) / self.focal_px)
         return self.height_m / math.tan(math.radians(self.pitch_deg) + half_vfov)
 

@@ -59,7 +59,7 @@ def description_template(
     if paper is not None:
         text = _sentences(text, description_additions().get(definition.name, ""))
     described = template_scopes(text, definition, world, scope)
-    return _sentences(text, naming_sentences(definition, ambiguous_in(world, definition, scope, described)))
+    return _sentences(text, naming_sentences(definition, ambiguous_in(world, definition, scope, described, text)))
 
 
 def naming_sentences(definition: TaskDefinition, ambiguous: list[str]) -> str:

@@ -58,7 +58,7 @@ from more_agent.records import FailureReason
 from more_agent.robot import XY, ActionResult, InstanceInfo, Observation
 from more_agent.robot_spec import full_turn_angles
 from more_agent.sim import actions, motion
-from more_agent.sim.camera import Camera
+from more_agent.sim.camera import Camera, camera_pose
 from more_agent.sim.goals import GoalChecker, GoalStatus
 from more_agent.sim.instantiate import TaskInstance, instantiate
 from more_agent.sim.navgrid import free_cells, nav_grid
@@ -443,16 +443,22 @@ class SimRobot:
     def low_level_steps(self) -> int:
         return self._steps
 
-    def sense(self, acted_on: Sequence[str] = ()) -> Observation:
+    def sense(self, acted_on: Sequence[str] = (), head: tuple[float, float] | None = None) -> Observation:
         """Render a frame from the current pose with what perception says of it.
 
         The robot knows what it did: an item released since the last frame is reported as no longer
         held, resting where it was put, even when no camera sees it (``Observation.placed`` keeps it,
         and what rode on or in it, at their boxes), and the objects in ``acted_on`` are reported with
-        their new state even when out of view.
+        their new state even when out of view. ``head`` (pan left, tilt down; radians) renders from the
+        head pointed away from its driving pose.
         """
         world = self._world
-        frame = self._renderer.render(world)
+        if head is None:
+            frame = self._renderer.render(world)
+        else:
+            r, camera = world.robot, self._renderer.camera
+            pose = camera_pose(r.x, r.y, r.yaw + head[0], height_m=camera.height_m, pitch_rad=head[1])
+            frame = self._renderer.render_at(world, pose)
         if self._on_frame is not None:
             self._on_frame(frame)
         table = instance_table(world, frame.instance)

@@ -25,13 +25,29 @@ CONTAINERS = {"wicker_basket": "inside", "bucket": "inside", "paper_bag": "insid
 ITEMS = ("apple", "hammer", "hardback", "apple", "hammer", "hardback")
 
 
-def _add_on_floor(world: World, name: str, category: str, kind: str, rng: np.random.Generator,
-                  size: tuple[float, float, float] | None = None) -> None:
+def _add_on_floor(
+    world: World,
+    name: str,
+    category: str,
+    kind: str,
+    rng: np.random.Generator,
+    size: tuple[float, float, float] | None = None,
+) -> None:
     dims = np.array(size or catalog.category_size(category), dtype=float)
     spot = free_floor_spot(world, "kitchen_0", dims[:2] / 2 + 0.3, rng)
     assert spot is not None, f"no room for {name}"
-    obj = world.add(WorldObject(name=name, category=category, kind=kind, room="kitchen_0", center=np.zeros(3),
-                                size=dims, openable=category == "car", is_open=category == "car"))
+    obj = world.add(
+        WorldObject(
+            name=name,
+            category=category,
+            kind=kind,
+            room="kitchen_0",
+            center=np.zeros(3),
+            size=dims,
+            openable=category == "car",
+            is_open=category == "car",
+        )
+    )
     if kind == "item":
         world.place_on_floor_at(name, "floor_kitchen_0", spot)
     else:
@@ -135,14 +151,17 @@ def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_ope
     body = Embodiment(SimRobot(world))
     body.look_around()
     bag = world.get("sack_1").label
-    fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))
     _act(body, world, "open", "door_0")
     _act(body, world, "grasp", "sack_1")
+    fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))  # labelled when first seen
+    assert len(fruit) == 4 and all(fruit), f"the robot looked down into the bag it grasped and saw all of {fruit}"
     graph = body.build()
     view = scene_view(graph, LanguageOptions())
     robot_room = view.room(view.robot_room)
     assert f"{bag} [held by the robot]" in robot_room.text()
-    assert all(_shown(view, f)[1] == ("inside", bag) and f in {o.name for o in robot_room.objects} for f in fruit), view.text()
+    assert all(_shown(view, f)[1] == ("inside", bag) and f in {o.name for o in robot_room.objects} for f in fruit), (
+        view.text()
+    )
     cell = graph.occupancy.frame.cell_of(np.array([body.xy]))[0]
     assert graph.occupancy.grid[cell[0], cell[1]] != 2, "what the robot carries maps as an obstacle where it stands"
     _act(body, world, "place_ontop", "breakfast_table_0")

@@ -68,9 +68,10 @@ def test_camera_pose_is_a_pitched_opencv_frame():
     assert np.allclose(R[:, 2], [0, math.cos(math.radians(20)), -math.sin(math.radians(20))])  # forward: north, down
     assert np.allclose(R[:, 0], [1, 0, 0])  # right of north is east
     K = Camera().intrinsics()
-    assert K[0, 0] == pytest.approx(128.0) and K[0, 2] == pytest.approx(127.5)  # 90 deg horizontal FOV
-    # OmniGibson's Fetch: a 17 mm focal length over a 20.955 mm aperture
-    assert OMNIGIBSON_FETCH_HFOV_DEG == pytest.approx(63.3, abs=0.05)
+    # OmniGibson's Fetch: a 17 mm focal length over a 20.955 mm aperture, the default
+    assert OMNIGIBSON_FETCH_HFOV_DEG == pytest.approx(63.3, abs=0.05) and Camera().hfov_deg == OMNIGIBSON_FETCH_HFOV_DEG
+    assert K[0, 0] == pytest.approx(128.0 * 17.0 / (20.955 / 2)) and K[0, 2] == pytest.approx(127.5)
+    assert Camera(hfov_deg=90.0).focal_px == pytest.approx(128.0)
     assert Camera(hfov_deg=OMNIGIBSON_FETCH_HFOV_DEG).blind_floor_m == pytest.approx(0.95, abs=0.005)
 
 

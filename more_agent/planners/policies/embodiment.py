@@ -23,10 +23,14 @@ from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.robot import XY, ActionResult, Frame, Robot
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT, full_turn_angles
 from more_agent.scene_graph import SceneGraph, SceneGraphBuilder
-from more_agent.sim.camera import Camera
 
 PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
+
+
+LOOK_AROUND_TILT_DEG = 55.0
+"""Head tilt of the downward looks in a full turn: with the Fetch's 63.3 deg view the image then spans 23 to
+87 deg below the horizon, the floor from right beside the base to 2.8 m out (``Embodiment.look_around``)."""
 
 
 class PolicyConfig(BaseModel):
@@ -54,10 +58,12 @@ class PolicyConfig(BaseModel):
         default=0.75, gt=0, description="Frontiers within this distance of one explored before are not chosen again."
     )
     blind_radius_m: float = Field(
-        default_factory=lambda: Camera().blind_floor_m,
+        default=ROBOT.radius_m + PLAN_MARGIN_M,
         ge=0,
-        description="Unknown cells this close to where the robot has been count as free on its map: the camera "
-        "never sees the floor this close to the robot (``Camera.blind_floor_m``: 0.56 m at 90 deg, 0.95 m at the Fetch's 63.3 deg).",
+        description="Unknown cells this close to where the robot has been count as free on its map: the floor under "
+        "and beside the base, which the head's downward looks (``look_around``, after a magic action's approach) "
+        "do not show on a real robot. The driving pitch alone never shows the floor within ``Camera.blind_floor_m`` "
+        "(0.95 m at the Fetch's 63.3 deg).",
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
 
@@ -102,11 +108,13 @@ class Embodiment:
         """Low-level steps since the episode began (the robot's count)."""
         return self.robot.low_level_steps
 
-    def sense(self, acted_on: Sequence[str] = ()) -> None:
+    def sense(self, acted_on: Sequence[str] = (), head: tuple[float, float] | None = None) -> None:
         """Sense a frame from the current pose and fuse it into the scene-graph builder: what the robot
         released since the last frame stays at its boxes until a frame shows it; ``acted_on`` (labels:
-        what it just opened or closed) are reported with their new state even when out of view."""
-        seen = self.robot.sense(acted_on)
+        what it just opened or closed) are reported with their new state even when out of view.
+        ``head`` (pan left, tilt down; radians) points the head away from its driving pose
+        (:meth:`look_down_at`)."""
+        seen = self.robot.sense(acted_on, head=head)
         if self.on_frame is not None:
             self.on_frame(seen.frame)
         for instance_id, box in seen.placed.items():
@@ -120,6 +128,26 @@ class Embodiment:
             self.observed.add(self.robot.held)
         self.observed.discard(0)
         self.schedule.fused(*self.robot.pose)
+
+    def look_down_at(self, xy: Sequence[float], acted_on: Sequence[str] = ()) -> None:
+        """Pan and tilt the head to the floor at ``xy`` and sense (the base turns only when ``xy`` lies beyond
+        the head's pan limit; head motions are no base steps and are not counted): the driving pitch leaves
+        the floor within ``Camera.blind_floor_m``, and what lies low in a bag or on a table beside the robot,
+        below the image. Aiming at the floor under an object puts its top and inside in view; through a
+        doorway, the floor of the next room."""
+        x, y, yaw = self.robot.pose
+        cam = ROBOT.camera
+        dx, dy = xy[0] - x, xy[1] - y
+        pan = math.atan2(dy, dx) - yaw if math.hypot(dx, dy) > 1e-6 else 0.0
+        pan = math.atan2(math.sin(pan), math.cos(pan))
+        if abs(pan) > math.radians(cam.head_pan_limit_deg):  # behind the head's reach: turn the base
+            self.face(xy)
+            pan = 0.0
+        tilt = min(
+            max(math.atan2(cam.height_m, math.hypot(dx, dy)), math.radians(cam.pitch_deg)),
+            math.radians(cam.head_tilt_limit_deg),
+        )
+        self.sense(acted_on, head=(pan, tilt))
 
     def sense_if_due(self) -> None:
         """Sense on the way: only when the schedule says the robot moved or turned far enough."""
@@ -172,10 +200,15 @@ class Embodiment:
             self.turn_by(math.atan2(dy, dx) - yaw, on_the_way=on_the_way)
 
     def look_around(self) -> None:
-        """A full turn in place, sensing after every turn (episode start, reached frontiers)."""
-        for angle in full_turn_angles():
+        """A full turn in place, sensing after every turn (episode start, reached frontiers), with the head
+        also tilted down after every other turn (``LOOK_AROUND_TILT_DEG``): the driving pitch never shows the
+        floor within ``Camera.blind_floor_m``, which would leave the robot standing in a hole of unknown
+        space that cuts it off from the map around it."""
+        for i, angle in enumerate(full_turn_angles()):
             self.robot.turn(angle)
             self.sense()
+            if i % 2 == 0:
+                self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))
 
     def follow(self, waypoints: Sequence[XY]) -> bool:
         """Drive along a polyline with low-level moves; False as soon as a move is blocked."""
@@ -188,7 +221,7 @@ class Embodiment:
                     reach = FORWARD_STEP_M + ROBOT.radius_m
                     x, y, yaw = self.robot.pose
                     self.bumps.append((x + reach * math.cos(yaw), y + reach * math.sin(yaw)))
-                    self.sense()
+                    self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))  # down at what the move met
                     return False
                 remaining -= distance  # a move below the full step is made whole or not at all
                 self.sense_if_due()
@@ -196,9 +229,11 @@ class Embodiment:
         return True
 
     def sense_after(self, result: ActionResult) -> None:
-        """Sense once a magic action has moved the robot (its path is not empty)."""
+        """Sense once a magic action has moved the robot (its path is not empty), also with the head down:
+        the approach ends where the robot may never have seen the floor."""
         if result.path:
             self.sense()
+            self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))
 
 
 def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:

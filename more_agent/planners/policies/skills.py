@@ -121,6 +121,7 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
     if not reached:
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: {why}", body.low_level_steps - start)
     body.face(target.position[:2])
+    body.look_down_at(target.position[:2])  # its top and inside, below the driving pitch from close by
     return ActionResult(
         ok=True, reason=None, feedback=f"reached {target.label}", low_level_steps=body.low_level_steps - start
     )
@@ -136,10 +137,12 @@ def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode
         moved = navigate(body, graph, target)
         if not moved.ok:
             return moved
+    elif not target.held:
+        body.look_down_at(target.position[:2])  # what lies in or on it, before it is acted on
     result = body.act(verb, target.label)  # the robot's go-to-and-act: the final approach when still out of reach
     body.sense_after(result)
-    if result.ok:
-        body.sense(acted_on=(target.label,))  # what opening / placing revealed; the new state even out of view
+    if result.ok:  # what opening / placing revealed; the new state even out of view
+        body.look_down_at(target.position[:2], acted_on=(target.label,))
     return ActionResult(
         ok=result.ok,
         reason=result.reason,
