@@ -101,6 +101,7 @@ def run_episode(
     ``bag`` (an open recorder) gets every frame the robot renders: ``run --bag`` (docs/ros.md).
     """
     from more_agent.llm.errors import LLMError
+    from more_agent.perception.model import perception_for
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
@@ -139,6 +140,7 @@ def run_episode(
         record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
+        perception = perception_for(spec.perception, world, spec.seed, spec.task)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
         planner.reset(
             EpisodeContext(
@@ -148,6 +150,7 @@ def run_episode(
                 history=spec.history,
                 on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
                 trace_graphs=folder is not None and folder.graphs,
+                perception=perception,
             )
         )
         clock.add("sense", t)
@@ -275,4 +278,8 @@ def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], pl
     record.task_progress = status.progress
     record.goal_conditions = list(status.conditions)
     record.observed_objects = observed_task_objects(scope, planner.observed_objects())
+    perception = getattr(planner, "body", None) and planner.body.perception
+    if perception:
+        record.misperceived = perception.misperceived(sorted(set(scope.values())))
+        record.perception_aliases = dict(perception.aliases)
     record.llm_usage = planner.llm_usage()

@@ -21,6 +21,7 @@ from more_agent.errors import UserError, unknown_name_error
 from more_agent.records import DEFAULT_HISTORY, HistoryMode, LLMUsage
 
 if TYPE_CHECKING:
+    from more_agent.perception.model import NoisyPerception
     from more_agent.planners.policies.embodiment import Embodiment
     from more_agent.scene_graph import SceneGraph
     from more_agent.sim.actions import ActionResult
@@ -83,6 +84,8 @@ class EpisodeContext:
     trace_graphs: bool = False
     """Whether each step's trace must carry the scene graph (``--save-graph``, ``--viewer``): a planner
     that does not plan on one builds it only then."""
+    perception: NoisyPerception | None = None
+    """The episode's perception errors (``--perception noisy``), for the planner's robot; None: ground truth."""
 
 
 @dataclass(frozen=True)

@@ -183,7 +183,12 @@ class BumblePlanner:
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer)."""
         writer = context.on_frame
-        self.body = Embodiment(context.instance.world, config=self.config.policy, mapping=self.config.mapping)
+        self.body = Embodiment(
+            context.instance.world,
+            config=self.config.policy,
+            mapping=self.config.mapping,
+            perception=context.perception,
+        )
         self.memory = VisualMemory(self.config.memory)
 
         def on_frame(frame: Frame) -> None:

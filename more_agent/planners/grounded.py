@@ -121,7 +121,9 @@ class GroundedPlanner:
     def reset(self, context: EpisodeContext) -> None:
         """Read the goal, start the robot with a full turn in place (paper S.3)."""
         self.goal: TaskGoal = task_goal(context.instance, context.goals)
-        self.body = Embodiment(context.instance.world, config=self.config, on_frame=context.on_frame)
+        self.body = Embodiment(
+            context.instance.world, config=self.config, on_frame=context.on_frame, perception=context.perception
+        )
         option = self.goal.options[0]
         self.skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
         """Literals no subpolicy can achieve (named when the planner calls done)."""
@@ -161,7 +163,7 @@ class GroundedPlanner:
         labels = {}
         for rid, region in graph.regions.items():
             if region.room_label is None:
-                kind = likely_room_type(o.category for o in graph.objects_in(rid))
+                kind = likely_room_type(body.room_input(graph.objects_in(rid)))
                 if kind is not None:
                     labels[rid] = kind
         if labels:

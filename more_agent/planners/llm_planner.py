@@ -147,7 +147,11 @@ class LLMPlanner:
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
         self.body = Embodiment(
-            context.instance.world, config=self.config.policy, mapping=self.config.mapping, on_frame=context.on_frame
+            context.instance.world,
+            config=self.config.policy,
+            mapping=self.config.mapping,
+            on_frame=context.on_frame,
+            perception=context.perception,
         )
         self.task = context.instance.description
         self.history, self.history_mode, self.feedback = [], context.history, ""
@@ -228,7 +232,7 @@ class LLMPlanner:
         a region whose answer stays invalid is left unlabelled and asked again next step."""
         labels: dict[str, str] = {}
         for rid, region in sorted(graph.regions.items()):
-            names = sorted({o.category for o in graph.objects_in(rid) if o.category != "door"})
+            names = sorted(set(self._body().room_input(o for o in graph.objects_in(rid) if o.category != "door")))
             if region.room_label is not None or not names:
                 continue
             try:

@@ -124,7 +124,7 @@ class OraclePlanner:
         self._last_failure: dict[tuple[str, tuple[str, ...]], tuple[str, str | None]] = {}
         """Per action, the feedback and blocking door of its last failure."""
         self._observed: set[str] = set()
-        self._body = Embodiment(context.instance.world, on_frame=context.on_frame)
+        self._body = Embodiment(context.instance.world, on_frame=context.on_frame, perception=context.perception)
         self._trace_graphs = context.trace_graphs
         self._graph: SceneGraph | None = None
         """The step's scene graph, built only for the trace (the oracle plans from the world)."""

@@ -7,20 +7,26 @@ rendered by the robot's own camera and fused into the
 :class:`~more_agent.scene_graph.SceneGraphBuilder` after every turn sequence and every few forward
 moves on the way (``PolicyConfig.sense_every_steps``), so the map grows while the robot drives.
 Perception is ground truth as in the paper (S.2): instance attributes, open state and how an object
-rests (inside / on top of what) are read from the world for the instances in view.
+rests (inside / on top of what) are read from the world for the instances in view. With a
+:class:`~more_agent.perception.NoisyPerception` (``--perception noisy``) the frames and the pose fused
+into the map carry its errors, and what it names is resolved back to the real object
+(:meth:`Embodiment.resolve`); the world and its magic actions stay exact.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
+from more_agent.perception.model import NoisyPerception, correctly_seen, real_ids
+from more_agent.perception.noise import FRAGMENT_BASE
 from more_agent.robot_spec import ROBOT
-from more_agent.scene_graph import InstanceInfo, SceneGraph, SceneGraphBuilder
+from more_agent.scene_graph import InstanceInfo, ObjectNode, SceneGraph, SceneGraphBuilder
 from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD, ActionResult, FailureReason
 from more_agent.sim.camera import Camera
 from more_agent.sim.env import ACTION_TYPES, MoreAgentEnv
@@ -77,6 +83,7 @@ class Embodiment:
         mapping: MappingConfig | None = None,
         renderer: Renderer | None = None,
         on_frame: Callable[[Frame], None] | None = None,
+        perception: NoisyPerception | None = None,
     ) -> None:
         self.world = world
         self.env = MoreAgentEnv(sensors=False, max_steps=None)
@@ -95,6 +102,8 @@ class Embodiment:
         self.on_frame = on_frame
         """Called with every rendered frame (``--save-frames`` writes them)."""
         self._held: str | None = None
+        self.perception = perception
+        """The episode's perception errors; None: ground truth."""
 
     @property
     def xy(self) -> XY:
@@ -111,15 +120,19 @@ class Embodiment:
         of view.
         """
         frame = self.renderer.render(self.world)
+        if self.perception is not None:
+            frame = self.perception.frame(frame)
         if self.on_frame is not None:
             self.on_frame(frame)
-        table = instance_table(self.world, frame.instance)
+        table = instance_table(self.world, real_ids(frame.instance) if self.perception else frame.instance)
         infos = {
             i: InstanceInfo(
                 label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
             )
             for i, d in table.items()
         }
+        if self.perception is not None:
+            infos = self._misnamed(infos, frame.instance)
         released = self._held if self._held is not None and self._held != self.world.robot.held else None
         for name in [*acted_on, *([released] if released is not None else [])]:
             obj = self.world.get(name)
@@ -138,7 +151,32 @@ class Embodiment:
                 self.builder.remember(obj.instance_id, *obj.box())
         self._held = self.world.robot.held
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
-        self.observed.update(d["name"] for d in table.values())
+        self.observed.update(correctly_seen(self.perception, {i: d["name"] for i, d in table.items()}))
+
+    def _misnamed(self, infos: dict[int, InstanceInfo], instance: np.ndarray) -> dict[int, InstanceInfo]:
+        """``infos`` with the names noisy perception gives: confused instances as their seen category under a
+        fresh label, and one more entry per fragment in view (ids ``FRAGMENT_BASE + i``), like its whole."""
+        assert self.perception is not None
+        out = dict(infos)
+        for i in np.unique(instance[instance >= FRAGMENT_BASE]).tolist():
+            if i - FRAGMENT_BASE in infos:
+                out[i] = infos[i - FRAGMENT_BASE]
+        for i, info in out.items():
+            named = self.perception.name(i, info.category)
+            if named is not None:
+                out[i] = info.model_copy(update={"label": named[0], "category": named[1]})
+        return out
+
+    def resolve(self, label: str) -> str | None:
+        """World name of the object a label means: one the robot's perception made up resolves to the real
+        object behind it, others as the env resolves them."""
+        made_up = self.perception.resolve(label) if self.perception is not None else None
+        return made_up or self.env.resolve(label)
+
+    def room_input(self, objects: Iterable[ObjectNode]) -> list[str]:
+        """The categories the room classifier reads for these objects (room-label noise, if any)."""
+        pairs = [(o.label, o.category) for o in objects]
+        return self.perception.room_input(pairs) if self.perception is not None else [c for _, c in pairs]
 
     def since_last_report(self, result: ActionResult) -> ActionResult:
         """``result`` with the low-level steps and path the robot made since the previous call (the first
@@ -235,6 +273,7 @@ class Embodiment:
                     return False
                 remaining -= distance  # a move below the full step is made whole or not at all
                 moved += 1
+                self._odometry(self.trajectory[-1], self.xy)
                 self.trajectory.append(self.xy)
                 if moved % self.config.sense_every_steps == 0:
                     self.sense()
@@ -250,4 +289,11 @@ class Embodiment:
     def add_motion(self, path: Sequence[XY], steps: int) -> None:
         """Count a motion made by a magic action (its path, start included, and low-level steps) without sensing."""
         self.low_level_steps += steps
-        self.trajectory.extend((float(x), float(y)) for x, y in path[1:])
+        for x, y in path[1:]:
+            self._odometry(self.trajectory[-1], (float(x), float(y)))
+            self.trajectory.append((float(x), float(y)))
+
+    def _odometry(self, before: XY, after: XY) -> None:
+        """Drift of the noisy perception's odometry for a move from ``before`` to ``after``."""
+        if self.perception is not None:
+            self.perception.moved(before, math.dist(before, after))

@@ -129,7 +129,7 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
 def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode) -> ActionResult:
     """navigate() unless the object is within reach, then the magic action on the world object."""
     start = body.low_level_steps
-    name = body.env.resolve(target.label)
+    name = body.resolve(target.label)
     if name is None:
         return _fail(FailureReason.UNKNOWN_OBJECT, f"unknown object {target.label}")
     if not target.held and actions.distance_to_footprint(body.world, name) > actions.REACH_M:

@@ -1,0 +1,174 @@
+"""One episode's noisy perception: the per-episode draws, the frame and pose errors, and the names it gives.
+
+:class:`NoisyPerception` turns each ground-truth frame into the frame a detector with the spec's errors
+reports (:mod:`more_agent.perception.noise`), keeps the odometry drift, and names what it sees: an
+instance seen as another category or as a second piece gets a fresh label of the category it is seen
+as (``World.fresh_label``), and :meth:`NoisyPerception.resolve` maps such a label back to the real
+object, so a magic action on it acts on the real object. The world is never changed by it. Its
+random generator is seeded by (episode seed, task), so an episode replays the same errors.
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Iterable, Mapping
+from dataclasses import replace
+
+import numpy as np
+
+from more_agent.perception.noise import (
+    FRAGMENT_BASE,
+    DepthNoise,
+    InstanceTables,
+    drift_step,
+    drifted_pose,
+    perturb_instances,
+)
+from more_agent.perception.taxonomy import sibling_category
+from more_agent.perception_spec import PerceptionSpec, parse_perception
+from more_agent.sim.render import Frame
+from more_agent.sim.world import World
+
+
+def perception_for(text: str, world: World, seed: int, task: str) -> NoisyPerception | None:
+    """The perception errors of an episode of ``task`` and ``seed`` in ``world`` for a mode's canonical text;
+    None for ground truth (or a noisy mode with every kind off)."""
+    spec = parse_perception(text)
+    return NoisyPerception(spec, world, episode_seed(seed, task)) if spec.noisy else None
+
+
+def episode_seed(seed: int, task: str) -> int:
+    """The seed of an episode's perception errors: its world seed and task, so reruns draw alike."""
+    return (seed * 1_000_003 + zlib.crc32(task.encode())) % 2**32
+
+
+def draw_tables(world: World, spec: PerceptionSpec, rng: np.random.Generator) -> InstanceTables:
+    """Per-instance sizes and the episode's draws of which instances are confused, split and merged."""
+    objects = [o for o in world.objects.values() if o.instance_id > 0]
+    n = max((o.instance_id for o in objects), default=0) + 1
+    size, eligible, seen_class = np.zeros(n), np.zeros(n, dtype=bool), np.zeros(n, dtype=np.int64)
+    vocabulary = {kind: sorted({o.category for o in objects if o.kind == kind}) for kind in ("item", "furniture")}
+    for o in objects:
+        size[o.instance_id] = float(np.max(np.asarray(o.size)))
+        eligible[o.instance_id] = o.kind in ("item", "furniture")
+        seen_class[o.instance_id] = world.semantic_id(o.category)
+    own, by_id = seen_class.copy(), {o.instance_id: o for o in objects}
+    draws = rng.random((3, n))
+    for i in np.flatnonzero(eligible & (draws[0] < spec.confusion)):
+        obj = by_id[int(i)]
+        other = sibling_category(
+            obj.category, vocabulary[obj.kind], rng
+        )  # items pass for items, furniture for furniture
+        if other is not None:
+            seen_class[i] = world.semantic_id(other)  # a category of the world: no new class
+    return InstanceTables(
+        size_m=size,
+        eligible=eligible,
+        seen_class=seen_class,
+        confused=seen_class != own,
+        fragment=eligible & (draws[1] < spec.fragment),
+        merge=eligible & (draws[2] < spec.merge),
+    )
+
+
+class NoisyPerception:
+    """The perception errors of one episode (see the module docstring)."""
+
+    def __init__(self, spec: PerceptionSpec, world: World, seed: int) -> None:
+        self.spec, self.world = spec, world
+        self.rng = np.random.default_rng(seed)
+        self.tables = draw_tables(world, spec, self.rng)
+        self.drift = np.eye(3)
+        self.depth_noise = DepthNoise(self.rng)
+        self._names = {o.instance_id: o.name for o in world.objects.values() if o.instance_id > 0}
+        self._labels: dict[int, str] = {}
+        """Perceived id -> the fresh label of a confused instance or a fragment."""
+        self.aliases: dict[str, str] = {}
+        """Fresh label -> world name of the real object."""
+        n = len(self.tables.size_m)
+        self.in_view, self.perceived = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        """Instances that were in view / perceived as themselves at least once."""
+        self._room_rng_seed = seed
+
+    def frame(self, frame: Frame) -> Frame:
+        """The frame as this perception reports it: noisy depth, perturbed semantic and instance frames,
+        the camera pose its drifting odometry believes in."""
+        found = perturb_instances(
+            frame.depth, frame.semantic, frame.instance, float(frame.K[0, 0]), self.tables, self.spec.miss, self.rng
+        )
+        self.in_view |= found.in_view
+        self.perceived |= found.kept & ~self.tables.confused
+        return replace(
+            frame,
+            depth=self.depth_noise.apply(frame.depth, self.spec.depth),
+            semantic=found.semantic,
+            instance=found.instance,
+            T_world_cam=drifted_pose(self.drift, frame.T_world_cam),
+        )
+
+    def moved(self, xy: tuple[float, float], distance_m: float) -> None:
+        """Odometry after driving ``distance_m`` from ``xy``."""
+        self.drift = drift_step(self.drift, xy, distance_m, self.spec.drift, self.rng)
+
+    def believed_xy(self, xy: tuple[float, float]) -> tuple[float, float]:
+        """Where the robot believes a true position ``xy`` is."""
+        x, y, _ = self.drift @ np.array([xy[0], xy[1], 1.0])
+        return float(x), float(y)
+
+    def name(self, perceived_id: int, category: str) -> tuple[str, str] | None:
+        """(label, category) of a confused instance or a fragment, None for one seen as itself."""
+        i = perceived_id - FRAGMENT_BASE if perceived_id >= FRAGMENT_BASE else perceived_id
+        confused = i < len(self.tables.confused) and bool(self.tables.confused[i])
+        if not confused and perceived_id < FRAGMENT_BASE:
+            return None
+        seen_as = self.world.class_names[int(self.tables.seen_class[i])] if confused else category
+        if perceived_id not in self._labels:
+            label = self.world.fresh_label(seen_as)
+            self._labels[perceived_id] = label
+            self.aliases[label] = self._names[i]
+        return self._labels[perceived_id], seen_as
+
+    def resolve(self, label: str) -> str | None:
+        """World name of the real object behind a label this perception made up, else None."""
+        return self.aliases.get(label.strip())
+
+    def room_input(self, categories: Iterable[tuple[str, str]]) -> list[str]:
+        """The categories the room classifier reads for (label, category) pairs: each object's, or, for the
+        ``room`` share of objects (fixed per object and episode), a random other category of the world."""
+        pool = sorted({o.category for o in self.world.objects.values() if o.kind in ("item", "furniture")})
+        out = []
+        for label, category in categories:
+            draw = np.random.default_rng((self._room_rng_seed, zlib.crc32(label.encode()))).random(2)
+            out.append(pool[int(draw[1] * len(pool))] if draw[0] < self.spec.room and pool else category)
+        return out
+
+    def misperceived(self, names: Iterable[str]) -> dict[str, str]:
+        """Of the world objects ``names``, those in view at some point but never perceived as themselves,
+        with how: seen as another category's label, merged into a neighbour, or not detected."""
+        by_name = {v: k for k, v in self._names.items()}
+        seen_as = {self._names[i]: lbl for i, lbl in self._labels.items() if i < FRAGMENT_BASE}
+        out = {}
+        for name in names:
+            i = by_name.get(name)
+            if i is None or not self.in_view[i] or self.perceived[i]:
+                continue
+            out[name] = (
+                f"seen as {seen_as[name]}"
+                if name in seen_as
+                else "merged into a neighbour"
+                if self.tables.merge[i]
+                else "not detected"
+            )
+        return out
+
+
+def real_ids(instance: np.ndarray) -> np.ndarray:
+    """The instance frame with fragments mapped back to the instance they are part of."""
+    return np.where(instance >= FRAGMENT_BASE, instance - FRAGMENT_BASE, instance)
+
+
+def correctly_seen(perception: NoisyPerception | None, names: Mapping[int, str]) -> set[str]:
+    """World names among ``names`` (id -> name) that ``perception`` has perceived as themselves (all without it)."""
+    if perception is None:
+        return set(names.values())
+    return {n for i, n in names.items() if i < len(perception.perceived) and perception.perceived[i]}
