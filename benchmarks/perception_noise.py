@@ -5,7 +5,8 @@ through the evaluation harness on ``TASKS`` (20 of the paper's tasks: every seco
 ``more-paper`` set in its order), seed 0, under ground-truth perception, under each error kind alone
 at its default rate, and under all kinds together; then SR against the rate for the two kinds that
 cost most SR, at half, one and two times their default rate. Each condition is a resumable run folder
-``<out>/<planner>/<perception>``. Prints one JSON line per condition (n, SR / TP / rTP in percent, SR
+``<out>/<planner>/<perception>``; a later run with a larger ``--limit`` adds the missing tasks to the
+same folders. Prints one JSON line per condition (n, SR / TP / rTP in percent, SR
 points lost against gt, failures per cause), writes ``<out>/<planner>/table.md`` (the table of
 docs/benchmarks.md) and ``<out>/<planner>/perception_noise.png`` (both figures). Run:
 ``nice -n 10 python benchmarks/perception_noise.py [--planner grounded] [--llm SPEC] [--workers 2]
@@ -48,7 +49,8 @@ def run_condition(args: argparse.Namespace, perception: PerceptionSpec) -> list[
         more_agent_version=__version__,
     )
     run_dir = args.out / args.planner / perception_part(text)
-    return evaluate(config, run_dir, resume=run_dir.exists(), show_progress=False)
+    records = evaluate(config, run_dir, resume=run_dir.exists(), allow_mixed=True, show_progress=False)
+    return [r for r in records if r.task in args.tasks and r.seed < args.seeds]  # a folder grows with --limit
 
 
 def row(name: str, records: list[EpisodeRecord], gt_sr: float | None) -> dict[str, object]:
