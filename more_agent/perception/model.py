@@ -85,10 +85,16 @@ class NoisyPerception:
         """Perceived id -> the fresh label of a confused instance or a fragment."""
         self.aliases: dict[str, str] = {}
         """Fresh label -> world name of the real object."""
+        self._seen_as: dict[str, str] = {}
+        """World label of a confused instance -> its fresh label."""
         n = len(self.tables.size_m)
         self.in_view, self.perceived = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         """Instances that were in view / perceived as themselves at least once."""
         self._room_rng_seed = seed
+        self.whole = np.zeros((0, 0), dtype=np.int32)
+        """The latest frame's instance frame with fragments under their whole instance's id."""
+        self.split = np.zeros(0, dtype=np.int64)
+        """The latest frame's instances seen in two pieces."""
 
     def frame(self, frame: Frame) -> Frame:
         """The frame as this perception reports it: noisy depth, perturbed semantic and instance frames,
@@ -98,6 +104,7 @@ class NoisyPerception:
         )
         self.in_view |= found.in_view
         self.perceived |= found.kept & ~self.tables.confused
+        self.whole, self.split = found.whole, found.split
         return replace(
             frame,
             depth=self.depth_noise.apply(frame.depth, self.spec.depth),
@@ -126,7 +133,20 @@ class NoisyPerception:
             label = self.world.fresh_label(seen_as)
             self._labels[perceived_id] = label
             self.aliases[label] = self._names[i]
+            if confused and perceived_id < FRAGMENT_BASE:
+                self._seen_as[self.world.reserve_label(self._names[i])] = label
         return self._labels[perceived_id], seen_as
+
+    def to_rename(self, ids: Iterable[int]) -> np.ndarray:
+        """Of the instance ids ``ids`` (those reported for a frame), those that need a made-up name: the
+        confused ones; then the latest frame's fragment ids."""
+        given = np.fromiter(ids, dtype=np.int64)
+        given = given[given < len(self.tables.confused)]
+        return np.concatenate([given[self.tables.confused[given]], self.split + FRAGMENT_BASE])
+
+    def seen_labels(self) -> dict[str, str]:
+        """World label -> the label perception gives, for the confused instances named so far."""
+        return self._seen_as
 
     def resolve(self, label: str) -> str | None:
         """World name of the real object behind a label this perception made up, else None."""
@@ -160,11 +180,6 @@ class NoisyPerception:
                 else "not detected"
             )
         return out
-
-
-def real_ids(instance: np.ndarray) -> np.ndarray:
-    """The instance frame with fragments mapped back to the instance they are part of."""
-    return np.where(instance >= FRAGMENT_BASE, instance - FRAGMENT_BASE, instance)
 
 
 def correctly_seen(perception: NoisyPerception | None, names: Mapping[int, str]) -> set[str]:

@@ -59,6 +59,10 @@ class Detections:
     """(H, W) semantic frame as perceived."""
     instance: np.ndarray
     """(H, W) instance frame as perceived (fragments at ``FRAGMENT_BASE + i``)."""
+    whole: np.ndarray
+    """(H, W) the same before fragmenting: each fragment under the id of its whole instance."""
+    split: np.ndarray
+    """(k,) ids of the instances seen in two pieces in this frame."""
     in_view: np.ndarray
     """(n,) bool: the instance was in the true frame."""
     kept: np.ndarray
@@ -102,21 +106,25 @@ def _columns(shape: tuple[int, int]) -> np.ndarray:
     return np.arange(shape[1], dtype=np.float64)[None, :]
 
 
-STATS_STRIDE = 2
-"""Mean depth and centroids are taken over every second pixel in each direction: a quarter of the cost of
-bincount sums with weights, well within a pixel for anything a detector can see."""
+STATS_STRIDE = 4
+"""Mean depth and centroids are taken over every fourth pixel in each direction (a sixteenth of the cost of
+bincount sums with weights, within a few pixels for anything a detector can see); an instance no sampled
+pixel hits counts as at the far end of the range."""
+FAR_M = 5.0
+"""Range given to an instance in view that no sampled pixel hits (a sliver): the camera's range."""
 
 
 def instance_stats(
     instance: np.ndarray, depth: np.ndarray, n: int, rows: bool = True
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per instance id < ``n``: pixel count (full frame), mean depth (NaN pixels count as 0 m; inf when
-    unseen) and pixel centroid (n, 2) as (column, row), these two over every ``STATS_STRIDE``-th pixel;
-    the row is 0 unless ``rows``."""
+    """Per instance id < ``n``: pixel count (full frame), mean depth (NaN pixels count as 0 m; ``FAR_M`` for a
+    sliver no sampled pixel hits, inf when unseen) and pixel centroid (n, 2) as (column, row), these two over
+    every ``STATS_STRIDE``-th pixel; the row is 0 unless ``rows``."""
     counts = np.bincount(instance.ravel(), minlength=n)[:n].astype(np.float64)
     sub = instance[::STATS_STRIDE, ::STATS_STRIDE].ravel()
     cols, rws = _pixel_coords(instance.shape)
-    safe = np.maximum(np.bincount(sub, minlength=n)[:n], 1.0)
+    sampled = np.bincount(sub, minlength=n)[:n]
+    safe = np.maximum(sampled, 1.0)
     mean_depth = (
         np.bincount(sub, weights=np.nan_to_num(depth[::STATS_STRIDE, ::STATS_STRIDE].ravel()), minlength=n)[:n] / safe
     )
@@ -124,6 +132,7 @@ def instance_stats(
     centroid[:, 0] = np.bincount(sub, weights=cols, minlength=n)[:n] / safe
     if rows:
         centroid[:, 1] = np.bincount(sub, weights=rws, minlength=n)[:n] / safe
+    mean_depth = np.where(sampled > 0, mean_depth, FAR_M)
     return counts, np.where(counts > 0, mean_depth, np.inf), centroid
 
 
@@ -183,8 +192,7 @@ def perturb_instances(
     relative's class. Decisions are made per instance id (one draw each per frame, whatever is in view)
     and applied to the frames as look-ups of per-instance tables.
     """
-    n = len(tables.size_m)
-    inst = np.where(instance < n, instance, 0)
+    n, inst = len(tables.size_m), instance  # the world's ids: all below n
     counts, mean_depth, centroid = instance_stats(inst, depth, n, rows=bool(tables.merge.any()))
     in_view = counts > 0
     counts[0] = 0
@@ -204,12 +212,19 @@ def perturb_instances(
         relabel = np.where(moved | tables.confused, np.where(lut > 0, tables.seen_class[lut], 0), -1)
         new_class = relabel[inst]
         out_sem = np.where(new_class >= 0, new_class, semantic).astype(semantic.dtype, copy=False)
+    whole = out_inst.astype(instance.dtype, copy=False)
     split = shown & ~moved & tables.fragment & (counts >= MIN_FRAGMENT_PIXELS)
+    pieces = whole
     if split.any():
-        right = _columns(inst.shape) > np.where(split, centroid[:, 0], np.inf)[out_inst]
-        out_inst = np.where(right, out_inst + FRAGMENT_BASE, out_inst)
+        right = _columns(inst.shape) > np.where(split, centroid[:, 0], np.inf)[whole]
+        pieces = np.where(right, whole + FRAGMENT_BASE, whole).astype(instance.dtype, copy=False)
     return Detections(
-        semantic=out_sem, instance=out_inst.astype(instance.dtype, copy=False), in_view=in_view, kept=in_view & ~moved
+        semantic=out_sem,
+        instance=pieces,
+        whole=whole,
+        split=np.flatnonzero(split),
+        in_view=in_view,
+        kept=in_view & ~moved,
     )
 
 

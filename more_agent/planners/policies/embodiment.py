@@ -19,11 +19,10 @@ import math
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
-from more_agent.perception.model import NoisyPerception, correctly_seen, real_ids
+from more_agent.perception.model import NoisyPerception, correctly_seen
 from more_agent.perception.noise import FRAGMENT_BASE
 from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import InstanceInfo, ObjectNode, SceneGraph, SceneGraphBuilder
@@ -124,15 +123,13 @@ class Embodiment:
             frame = self.perception.frame(frame)
         if self.on_frame is not None:
             self.on_frame(frame)
-        table = instance_table(self.world, real_ids(frame.instance) if self.perception else frame.instance)
+        table = instance_table(self.world, self.perception.whole if self.perception else frame.instance)
         infos = {
             i: InstanceInfo(
                 label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
             )
             for i, d in table.items()
         }
-        if self.perception is not None:
-            infos = self._misnamed(infos, frame.instance)
         released = self._held if self._held is not None and self._held != self.world.robot.held else None
         for name in [*acted_on, *([released] if released is not None else [])]:
             obj = self.world.get(name)
@@ -146,6 +143,8 @@ class Embodiment:
                     rests=self._rests(name),
                 ),
             )
+        if self.perception is not None:
+            infos = self._misnamed(infos)
         if released is not None:
             for obj in [self.world.get(released), *self.world.descendants(released)]:  # with what rode on it
                 self.builder.remember(obj.instance_id, *obj.box())
@@ -153,18 +152,22 @@ class Embodiment:
         self.builder.integrate(frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, infos, self.xy)
         self.observed.update(correctly_seen(self.perception, {i: d["name"] for i, d in table.items()}))
 
-    def _misnamed(self, infos: dict[int, InstanceInfo], instance: np.ndarray) -> dict[int, InstanceInfo]:
-        """``infos`` with the names noisy perception gives: confused instances as their seen category under a
-        fresh label, and one more entry per fragment in view (ids ``FRAGMENT_BASE + i``), like its whole."""
-        assert self.perception is not None
+    def _misnamed(self, infos: dict[int, InstanceInfo]) -> dict[int, InstanceInfo]:
+        """``infos`` as noisy perception names them: confused instances (in view, held or acted on) under
+        their seen category and a fresh label, one more entry per fragment in view (id ``FRAGMENT_BASE + i``,
+        like its whole), and supports named as perceived."""
+        noise = self.perception
+        assert noise is not None
         out = dict(infos)
-        for i in np.unique(instance[instance >= FRAGMENT_BASE]).tolist():
-            if i - FRAGMENT_BASE in infos:
-                out[i] = infos[i - FRAGMENT_BASE]
-        for i, info in out.items():
-            named = self.perception.name(i, info.category)
-            if named is not None:
+        for i in noise.to_rename(infos).tolist():
+            info = infos.get(i - FRAGMENT_BASE if i >= FRAGMENT_BASE else i)
+            named = noise.name(i, info.category) if info is not None else None
+            if info is not None and named is not None:
                 out[i] = info.model_copy(update={"label": named[0], "category": named[1]})
+        seen_as = noise.seen_labels()
+        for i, info in out.items():
+            if info.rests is not None and info.rests[1] in seen_as:
+                out[i] = info.model_copy(update={"rests": (info.rests[0], seen_as[info.rests[1]])})
         return out
 
     def resolve(self, label: str) -> str | None:
