@@ -33,10 +33,10 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from more_agent.eval.episode import reset_planner
 from more_agent.llm import CacheMode, ChatClient, ChatMessage, Completion, Unparseable, load_llm_config, make_client
 from more_agent.llm.llamacpp_backend import LlamaCppBackend
 from more_agent.llm.reask import REASK_TEMPLATE
-from more_agent.planners.base import EpisodeContext
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.sim.goals import GoalChecker
 from more_agent.sim.instantiate import instantiate
@@ -134,7 +134,7 @@ def run_task(task: str, client: MeasuredClient, steps: int, seed: int) -> dict[s
     instance = instantiate(task, scene, seed)
     planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, f"llamacpp:{client.model}"))
     first_call = len(client.calls)
-    planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
+    reset_planner(planner, instance, GoalChecker(instance))
     step_s, cpu_s, llm_s = [], [], []
     for _ in range(steps):
         t0, c0, waited = time.perf_counter(), time.process_time(), planner.llm_usage().seconds

@@ -126,6 +126,7 @@ def run_scene(name: str, items: bool = True) -> dict:
 
     from more_agent.planners.policies import Embodiment
     from more_agent.sim.clutter import add_distractors, clutter_rng
+    from more_agent.sim.env import SimRobot
     from more_agent.sim.navgrid import nav_grid
     from more_agent.sim.scenes import get_scene
     from more_agent.sim.world import World
@@ -135,7 +136,7 @@ def run_scene(name: str, items: bool = True) -> dict:
     for door in world.scene.doors:
         world.set_open(door.id, True)
     grid = nav_grid(world)
-    body = Embodiment(world)
+    body = Embodiment(SimRobot(world))
     fuse_times: list[float] = []
     integrate = body.builder.integrate
 

@@ -29,6 +29,7 @@ from more_agent.eval.store import RunConfig, perception_part
 from more_agent.perception_spec import DEFAULTS, ERROR_KINDS, PerceptionSpec
 from more_agent.records import EpisodeRecord
 from more_agent.sim.tasks import task_set
+from more_agent.sim.world import World
 
 TASKS = task_set("more-paper")[::2][:20]
 """Every second task of the paper's set, in its order: 20 tasks across its scenes."""
@@ -114,17 +115,22 @@ def step_time(task: str, steps: int) -> dict[str, object]:
     import time
 
     from more_agent.perception.model import NoisyPerception
+    from more_agent.perception.robot import NoisyRobot
     from more_agent.planners.policies import Embodiment
+    from more_agent.robot import Robot
+    from more_agent.sim.env import SimRobot
     from more_agent.sim.instantiate import instantiate
-    from more_agent.sim.navgrid import free_cells, nav_grid, shortest_path
+    from more_agent.sim.navgrid import free_cells, nav_grid
+    from more_agent.sim.paths import shortest_path
+
+    def robot(world: World, noisy: bool) -> Robot:
+        return NoisyRobot(SimRobot(world), NoisyPerception(PerceptionSpec(mode="noisy"), world, 0)) if noisy else SimRobot(world)
 
     bodies, spent, frames = {}, {"gt": 0.0, "noisy": 0.0}, {"gt": 0, "noisy": 0}
     for mode in spent:
+        Embodiment(robot(instantiate(task, None, 1).world, mode == "noisy")).look_around()  # warm-up, untimed
         world = instantiate(task, None, 0).world
-        noise = NoisyPerception(PerceptionSpec(mode="noisy"), world, 0) if mode == "noisy" else None
-        warm = instantiate(task, None, 1).world  # warm-up, untimed: compiled kernels, lazy imports
-        Embodiment(warm, perception=NoisyPerception(PerceptionSpec(mode="noisy"), warm, 1) if noise else None).look_around()
-        body = bodies[mode] = Embodiment(world, perception=noise)
+        body = bodies[mode] = Embodiment(robot(world, mode == "noisy"))
 
         def timed(sense=body.sense, mode=mode, **kw: object) -> None:
             t = time.process_time()
@@ -133,7 +139,7 @@ def step_time(task: str, steps: int) -> dict[str, object]:
             frames[mode] += 1
 
         body.sense = timed  # type: ignore[method-assign]
-    grid = nav_grid(bodies["gt"].world)
+    grid = nav_grid(world)
     cells = free_cells(grid.free)
     paths, at = [], bodies["gt"].xy
     for c in cells[np.random.default_rng(0).permutation(len(cells))]:
@@ -144,7 +150,7 @@ def step_time(task: str, steps: int) -> dict[str, object]:
             paths.append([tuple(p) for p in path.waypoints])
             at = paths[-1][-1]
     for k in range(-1, len(paths)):
-        for body in sorted(bodies.values(), key=lambda b: (b.perception is None) == (k % 2 == 0)):  # take turns first
+        for body in sorted(bodies.values(), key=lambda b: isinstance(b.robot, SimRobot) == (k % 2 == 0)):  # turns first
             if k < 0:
                 body.look_around()
             else:

@@ -42,12 +42,12 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from more_agent.errors import UserError  # noqa: E402
+from more_agent.eval.episode import reset_planner  # noqa: E402
 from more_agent.llm import plan_messages  # noqa: E402
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage  # noqa: E402
 from more_agent.llm.errors import LLMConfigError  # noqa: E402
 from more_agent.llm.llamacpp_backend import LlamaCppBackend  # noqa: E402
 from more_agent.llm.local_models import bundled_model_path  # noqa: E402
-from more_agent.planners.base import EpisodeContext  # noqa: E402
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner  # noqa: E402
 from more_agent.sim.goals import GoalChecker  # noqa: E402
 from more_agent.sim.instantiate import instantiate  # noqa: E402
@@ -161,7 +161,7 @@ def run_scene(scene: str, steps: int, seed: int, open_doors: bool = True, task: 
     categories = {instance.world.get(n).category for n in instance.scope.values() if n in instance.world.objects}
     llm = ScriptedLLM(categories)
     planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(llm, llm, "scripted"))
-    planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
+    reset_planner(planner, instance, GoalChecker(instance))
     rows = []
     for _ in range(steps):
         calls_before = planner.llm_usage().calls

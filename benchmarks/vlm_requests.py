@@ -33,9 +33,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from prompt_tokens import ScriptedLLM, pick_task  # noqa: E402  (benchmarks/ is on the path when run as a script)
 
+from more_agent.eval.episode import reset_planner  # noqa: E402
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage  # noqa: E402
 from more_agent.llm.images import image_stats  # noqa: E402
-from more_agent.planners.base import EpisodeContext  # noqa: E402
 from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner  # noqa: E402
 from more_agent.planners.visual_memory import VisualMemory  # noqa: E402
 from more_agent.sim.goals import GoalChecker  # noqa: E402
@@ -100,7 +100,7 @@ def run(scene: str, planner_name: str, steps: int, seed: int) -> dict[str, objec
     categories = {instance.world.get(n).category for n in instance.scope.values() if n in instance.world.objects}
     vlm = ScriptedVLM(categories)
     planner = BumblePlanner(BUMBLE_CONFIGS[planner_name], vlm, "scripted")
-    planner.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance)))
+    reset_planner(planner, instance, GoalChecker(instance))
     memory = TimedMemory(planner.config.memory)
     memory.frames, planner.memory = planner.memory.frames, memory
     rows = []

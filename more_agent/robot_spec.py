@@ -68,3 +68,15 @@ class RobotSpec:
 
 ROBOT = RobotSpec()
 """The robot every episode runs with."""
+
+FORWARD_STEP_M = 0.075
+"""Length of one low-level forward move (paper S.3)."""
+
+MAX_TURN_RAD = math.radians(35)
+"""Largest low-level turn (paper S.3)."""
+
+
+def full_turn_angles(max_turn: float = MAX_TURN_RAD) -> list[float]:
+    """Equal left turns of at most ``max_turn`` that add up to one full turn (11 of 32.7 deg for 35 deg)."""
+    n = math.ceil(2 * math.pi / max_turn - 1e-9)
+    return [2 * math.pi / n] * n

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from more_agent.cli import app
 from more_agent.commands.run import NO_LLM_MESSAGE
-from more_agent.sim.motion import full_turn_angles
+from more_agent.robot_spec import full_turn_angles
 
 runner = CliRunner()
 TASK = "putting_shopping_away"

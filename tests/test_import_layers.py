@@ -12,7 +12,7 @@ ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
     ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills",
-     "robot_spec", "vocabulary", "perception_spec"),
+     "robot_spec", "vocabulary", "robot", "goal", "perception_spec"),
     ("sim",),
     ("perception",),
     ("mapping",),

@@ -5,8 +5,10 @@ its ``error_kind`` (and ``record.traceback`` when code raised; an LLM error is r
 Every planner, the oracle and the LLM planners alike, runs through this one loop. Termination follows
 the paper (Sec. III-D, :mod:`more_agent.eval.termination`) and is recorded typed in
 ``record.termination``: the planner calls ``done``, ``MAX_HIGH_LEVEL_STEPS`` high-level steps pass, or the
-planner keeps acting for more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. The step's motion (low-level
-steps and path) is read from the planner's robot, the same way for every planner. With ``out_dir``
+planner keeps acting for more than ``STEPS_AFTER_GOAL`` steps after every goal condition holds. The runner
+builds the robot a planner drives (:class:`~more_agent.sim.env.SimRobot`) and what it is told of the task
+(:class:`~more_agent.goal.GoalSpec`); only a privileged planner (the oracle) is granted the world and the
+goal checker. The step's motion (low-level steps and path) is read from the robot, the same way for every planner. With ``out_dir``
 an :class:`~more_agent.eval.episode_folder.EpisodeFolder` writes the episode's files: the record,
 the map, each step's timeline line and the planner's step trace. Timings are seconds per phase:
 instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
@@ -18,7 +20,7 @@ from __future__ import annotations
 
 import time
 import traceback
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -26,16 +28,20 @@ from more_agent.errors import UserError
 from more_agent.eval.episode_folder import EpisodeFolder
 from more_agent.eval.failure import classify_failure
 from more_agent.eval.termination import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL
+from more_agent.goal import GoalSpec
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
-from more_agent.records import ActionRecord, EpisodeRecord, EpisodeSpec, WorldStats
+from more_agent.records import DEFAULT_HISTORY, ActionRecord, EpisodeRecord, EpisodeSpec, HistoryMode, WorldStats
 from more_agent.redaction import redact
+from more_agent.robot import XY
 from more_agent.safe_files import DISK_FULL_ERRNOS
-from more_agent.sim.navgrid import XY
 
 if TYPE_CHECKING:
     from more_agent.interop.bag_writer import BagRecorder
-    from more_agent.sim.goals import GoalChecker, GoalStatus
+    from more_agent.perception.model import NoisyPerception
+    from more_agent.robot import Frame
+    from more_agent.sim.env import SimRobot
+    from more_agent.sim.goals import GoalChecker, GoalStatus, PrivilegedContext
     from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.world import World
 
@@ -119,6 +125,9 @@ def run_episode(
     )
     world: World | None = None
     goals: GoalChecker | None = None
+    robot: SimRobot | None = None
+    perception: NoisyPerception | None = None
+    privileged: PrivilegedContext | None = None
     scope: dict[str, str] = {}
     if folder is not None:
         folder.clear()  # an earlier episode's steps and frames must never show in this one's viewer
@@ -142,21 +151,20 @@ def run_episode(
         t = clock.add("instantiate", t)
         perception = perception_for(spec.perception, world, spec.seed, spec.task)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
-        planner.reset(
-            EpisodeContext(
-                instance=instance,
-                goals=goals,
-                llm=planner.llm,
-                history=spec.history,
-                on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
-                trace_graphs=folder is not None and folder.graphs,
-                perception=perception,
-            )
+        robot, privileged = reset_planner(
+            planner,
+            instance,
+            goals,
+            descriptions=spec.descriptions,
+            history=spec.history,
+            on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
+            trace_graphs=folder is not None and folder.graphs,
+            perception=perception,
         )
         clock.add("sense", t)
         if folder is not None:
             folder.start(steps_log=planner.llm is not None)
-        _run_steps(record, planner, goals, world, clock, folder)
+        _run_steps(record, planner, robot, goals, world, clock, folder)
     except LLMError as e:
         record.error, record.error_kind = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}", "llm"
         record.retryable = e.retryable
@@ -169,7 +177,12 @@ def run_episode(
         record.traceback = redact(traceback.format_exc())
         record.retryable = isinstance(e, OSError) and e.errno in DISK_FULL_ERRNOS  # free space, run again
     if world is not None and goals is not None and planner is not None:
-        _finish(record, goals.check(world), scope, planner)
+        seen = perception.observed() if perception is not None else robot.observed if robot is not None else set()
+        observed = seen | (privileged.observed if privileged else set())
+        _finish(record, goals.check(world), scope, planner, observed)
+        if perception is not None:
+            record.misperceived = perception.misperceived(sorted(set(scope.values())))
+            record.perception_aliases = dict(perception.aliases)
     record.failure = classify_failure(record, world)
     if folder is not None:
         t = time.perf_counter()
@@ -181,6 +194,45 @@ def run_episode(
     if folder is not None:
         folder.write_record(record)
     return record
+
+
+def reset_planner(
+    planner: Planner,
+    instance: TaskInstance,
+    goals: GoalChecker,
+    *,
+    descriptions: str = "named",
+    history: HistoryMode = DEFAULT_HISTORY,
+    on_frame: Callable[[Frame], None] | None = None,
+    trace_graphs: bool = False,
+    perception: NoisyPerception | None = None,
+) -> tuple[SimRobot, PrivilegedContext | None]:
+    """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
+    gets every frame it renders; with ``perception``, the planner drives it through a
+    :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`), grant the
+    world and the goal checker to a privileged planner (one with ``grant``: the oracle), then ``reset``
+    it. Returns the simulator's robot and the privileged context (None for any other planner)."""
+    from more_agent.perception.robot import NoisyRobot
+    from more_agent.sim.env import SimRobot
+    from more_agent.sim.goals import PrivilegedContext
+
+    robot = SimRobot(instance.world, on_frame=on_frame)
+    grant = getattr(planner, "grant", None)
+    privileged = PrivilegedContext(world=instance.world, goals=goals) if grant is not None else None
+    if grant is not None:
+        grant(privileged)
+    goal = goal_spec(instance, goals, descriptions, with_goal=getattr(planner, "reads_goal", False))
+    driven = robot if perception is None else NoisyRobot(robot, perception)
+    planner.reset(EpisodeContext(robot=driven, goal=goal, llm=planner.llm, history=history, trace_graphs=trace_graphs))
+    return robot, privileged
+
+
+def goal_spec(instance: TaskInstance, goals: GoalChecker, descriptions: str, *, with_goal: bool) -> GoalSpec:
+    """What a planner is told of its task: the description, and the goal's literals when it reads them."""
+    from more_agent.sim.task_goal import task_goal
+
+    goal = task_goal(instance, goals) if with_goal else None
+    return GoalSpec(text=instance.description, descriptions=descriptions, goal=goal)
 
 
 def world_stats(instance: TaskInstance) -> WorldStats:
@@ -220,6 +272,7 @@ def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
 def _run_steps(
     record: EpisodeRecord,
     planner: Planner,
+    robot: SimRobot,
     goals: GoalChecker,
     world: World,
     clock: _Clock,
@@ -237,7 +290,7 @@ def _run_steps(
         t = clock.add("plan", t)
         # The outcome with the robot's low-level steps and path since the last step (the first step's
         # include the initial full turn).
-        result = planner.body.since_last_report(planner.execute(action))
+        result = robot.since_last_report(planner.execute(action))
         status = goals.check(world)
         clock.add("act", t)
         record.actions.append(
@@ -271,15 +324,13 @@ def _run_steps(
     record.termination = "step_limit"
 
 
-def _finish(record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], planner: Planner) -> None:
-    """Goal outcome, what was observed and the LLM traffic, from the final state."""
+def _finish(
+    record: EpisodeRecord, status: GoalStatus, scope: dict[str, str], planner: Planner, observed: set[str]
+) -> None:
+    """Goal outcome, what was observed (world names) and the LLM traffic, from the final state."""
     record.all_goals_met = status.all_met
     record.success = status.all_met and record.done_called
     record.task_progress = status.progress
     record.goal_conditions = list(status.conditions)
-    record.observed_objects = observed_task_objects(scope, planner.observed_objects())
-    perception = getattr(planner, "body", None) and planner.body.perception
-    if perception:
-        record.misperceived = perception.misperceived(sorted(set(scope.values())))
-        record.perception_aliases = dict(perception.aliases)
+    record.observed_objects = observed_task_objects(scope, observed)
     record.llm_usage = planner.llm_usage()

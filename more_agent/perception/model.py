@@ -1,11 +1,13 @@
 """One episode's noisy perception: the per-episode draws, the frame and pose errors, and the names it gives.
 
-:class:`NoisyPerception` turns each ground-truth frame into the frame a detector with the spec's errors
-reports (:mod:`more_agent.perception.noise`), keeps the odometry drift, and names what it sees: an
-instance seen as another category or as a second piece gets a fresh label of the category it is seen
-as (``World.fresh_label``), and :meth:`NoisyPerception.resolve` maps such a label back to the real
-object, so a magic action on it acts on the real object. The world is never changed by it. Its
+:class:`NoisyPerception` turns each ground-truth observation into the one a detector with the spec's
+errors reports (:mod:`more_agent.perception.noise`), keeps the odometry drift, and names what it sees:
+an instance seen as another category or as a second piece gets a fresh label of the category it is
+seen as (``World.fresh_label``), and :meth:`NoisyPerception.real_label` maps such a label back to the
+real object's, so a magic action on it acts on the real object. It reads the simulator's world for
+what a detector's errors depend on (sizes, kinds, categories, names) and never changes its state. Its
 random generator is seeded by (episode seed, task), so an episode replays the same errors.
+:class:`~more_agent.perception.robot.NoisyRobot` puts it between the simulator's robot and a planner.
 """
 
 from __future__ import annotations
@@ -17,7 +19,6 @@ from dataclasses import replace
 import numpy as np
 
 from more_agent.perception.noise import (
-    FRAGMENT_BASE,
     DepthNoise,
     InstanceTables,
     drift_step,
@@ -26,7 +27,7 @@ from more_agent.perception.noise import (
 )
 from more_agent.perception.taxonomy import sibling_category
 from more_agent.perception_spec import PerceptionSpec, parse_perception
-from more_agent.sim.render import Frame
+from more_agent.robot import Frame, InstanceInfo
 from more_agent.sim.world import World
 
 
@@ -56,9 +57,7 @@ def draw_tables(world: World, spec: PerceptionSpec, rng: np.random.Generator) ->
     draws = rng.random((3, n))
     for i in np.flatnonzero(eligible & (draws[0] < spec.confusion)):
         obj = by_id[int(i)]
-        other = sibling_category(
-            obj.category, vocabulary[obj.kind], rng
-        )  # items pass for items, furniture for furniture
+        other = sibling_category(obj.category, vocabulary[obj.kind], rng)  # items for items, furniture for furniture
         if other is not None:
             seen_class[i] = world.semantic_id(other)  # a category of the world: no new class
     return InstanceTables(
@@ -75,9 +74,11 @@ class NoisyPerception:
     """The perception errors of one episode (see the module docstring)."""
 
     def __init__(self, spec: PerceptionSpec, world: World, seed: int) -> None:
-        self.spec, self.world = spec, world
+        self.spec, self.world, self.seed = spec, world, seed
         self.rng = np.random.default_rng(seed)
         self.tables = draw_tables(world, spec, self.rng)
+        self.fragments = len(self.tables.size_m)
+        """Fragment ids: ``fragments + i`` is the second piece of instance ``i``."""
         self.drift = np.eye(3)
         self.depth_noise = DepthNoise(self.rng)
         self._names = {o.instance_id: o.name for o in world.objects.values() if o.instance_id > 0}
@@ -87,103 +88,96 @@ class NoisyPerception:
         """Fresh label -> world name of the real object."""
         self._seen_as: dict[str, str] = {}
         """World label of a confused instance -> its fresh label."""
-        n = len(self.tables.size_m)
+        n = self.fragments
         self.in_view, self.perceived = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         """Instances that were in view / perceived as themselves at least once."""
-        self._room_rng_seed = seed
-        self.whole = np.zeros((0, 0), dtype=np.int32)
-        """The latest frame's instance frame with fragments under their whole instance's id."""
-        self.split = np.zeros(0, dtype=np.int64)
-        """The latest frame's instances seen in two pieces."""
 
-    def frame(self, frame: Frame) -> Frame:
-        """The frame as this perception reports it: noisy depth, perturbed semantic and instance frames,
-        the camera pose its drifting odometry believes in."""
+    def observe(
+        self, frame: Frame, instances: Mapping[int, InstanceInfo], known: Iterable[int] = ()
+    ) -> tuple[Frame, dict[int, InstanceInfo]]:
+        """A ground-truth frame and what perception says of its instances as this perception reports them:
+        noisy depth, perturbed semantic and instance images, the camera pose its odometry believes in;
+        missed and merged instances dropped (unless ``known``: held, just acted on or released, which the
+        robot knows without a camera), the rest named as seen."""
         found = perturb_instances(
             frame.depth, frame.semantic, frame.instance, float(frame.K[0, 0]), self.tables, self.spec.miss, self.rng
         )
         self.in_view |= found.in_view
         self.perceived |= found.kept & ~self.tables.confused
-        self.whole, self.split = found.whole, found.split
-        return replace(
+        hidden = set(np.flatnonzero(found.in_view & ~found.kept).tolist()) - set(known) - {0}
+        infos = {i: info for i, info in instances.items() if i not in hidden}
+        seen = replace(
             frame,
             depth=self.depth_noise.apply(frame.depth, self.spec.depth),
             semantic=found.semantic,
             instance=found.instance,
             T_world_cam=drifted_pose(self.drift, frame.T_world_cam),
         )
+        return seen, self._named(infos, found.split)
 
-    def moved(self, xy: tuple[float, float], distance_m: float) -> None:
-        """Odometry after driving ``distance_m`` from ``xy``."""
-        self.drift = drift_step(self.drift, xy, distance_m, self.spec.drift, self.rng)
+    def _named(self, infos: dict[int, InstanceInfo], split: np.ndarray) -> dict[int, InstanceInfo]:
+        """``infos`` as this perception names them: confused instances under their seen category and a fresh
+        label, one more entry per fragment (like its whole), supports named as perceived."""
+        out = dict(infos)
+        given = np.fromiter(infos, dtype=np.int64)
+        given = given[(given > 0) & (given < self.fragments)]
+        for i in [*given[self.tables.confused[given]].tolist(), *(split + self.fragments).tolist()]:
+            info = infos.get(i - self.fragments if i >= self.fragments else i)
+            if info is not None:
+                label, category = self._name(i, info.category)
+                out[i] = info.model_copy(update={"label": label, "category": category})
+        if self._seen_as:
+            for i, info in out.items():
+                if info.rests is not None and info.rests[1] in self._seen_as:
+                    out[i] = info.model_copy(update={"rests": (info.rests[0], self._seen_as[info.rests[1]])})
+        return out
 
-    def believed_xy(self, xy: tuple[float, float]) -> tuple[float, float]:
-        """Where the robot believes a true position ``xy`` is."""
-        x, y, _ = self.drift @ np.array([xy[0], xy[1], 1.0])
-        return float(x), float(y)
-
-    def name(self, perceived_id: int, category: str) -> tuple[str, str] | None:
-        """(label, category) of a confused instance or a fragment, None for one seen as itself."""
-        i = perceived_id - FRAGMENT_BASE if perceived_id >= FRAGMENT_BASE else perceived_id
-        confused = i < len(self.tables.confused) and bool(self.tables.confused[i])
-        if not confused and perceived_id < FRAGMENT_BASE:
-            return None
+    def _name(self, perceived_id: int, category: str) -> tuple[str, str]:
+        """(label, category) of a confused instance or a fragment (``category``: its whole's as reported)."""
+        i = perceived_id - self.fragments if perceived_id >= self.fragments else perceived_id
+        confused = bool(self.tables.confused[i])
         seen_as = self.world.class_names[int(self.tables.seen_class[i])] if confused else category
         if perceived_id not in self._labels:
             label = self.world.fresh_label(seen_as)
             self._labels[perceived_id] = label
             self.aliases[label] = self._names[i]
-            if confused and perceived_id < FRAGMENT_BASE:
+            if confused and perceived_id < self.fragments:
                 self._seen_as[self.world.reserve_label(self._names[i])] = label
         return self._labels[perceived_id], seen_as
 
-    def to_rename(self, ids: Iterable[int]) -> np.ndarray:
-        """Of the instance ids ``ids`` (those reported for a frame), those that need a made-up name: the
-        confused ones; then the latest frame's fragment ids."""
-        given = np.fromiter(ids, dtype=np.int64)
-        given = given[given < len(self.tables.confused)]
-        return np.concatenate([given[self.tables.confused[given]], self.split + FRAGMENT_BASE])
+    def moved(self, xy: tuple[float, float], distance_m: float) -> None:
+        """Odometry after driving ``distance_m`` from ``xy``."""
+        self.drift = drift_step(self.drift, xy, distance_m, self.spec.drift, self.rng)
 
-    def seen_labels(self) -> dict[str, str]:
-        """World label -> the label perception gives, for the confused instances named so far."""
-        return self._seen_as
+    def real_label(self, label: str) -> str:
+        """The real object's label behind a label this perception made up; any other label as it is."""
+        name = self.aliases.get(label.strip())
+        return label if name is None else self.world.reserve_label(name)
 
-    def resolve(self, label: str) -> str | None:
-        """World name of the real object behind a label this perception made up, else None."""
-        return self.aliases.get(label.strip())
-
-    def room_input(self, categories: Iterable[tuple[str, str]]) -> list[str]:
+    def room_input(self, objects: Iterable[tuple[str, str]]) -> list[str]:
         """The categories the room classifier reads for (label, category) pairs: each object's, or, for the
         ``room`` share of objects (fixed per object and episode), a random other category of the world."""
         pool = sorted({o.category for o in self.world.objects.values() if o.kind in ("item", "furniture")})
         out = []
-        for label, category in categories:
-            draw = np.random.default_rng((self._room_rng_seed, zlib.crc32(label.encode()))).random(2)
+        for label, category in objects:
+            draw = np.random.default_rng((self.seed, zlib.crc32(label.encode()))).random(2)
             out.append(pool[int(draw[1] * len(pool))] if draw[0] < self.spec.room and pool else category)
         return out
+
+    def observed(self) -> set[str]:
+        """World names of the objects perceived as themselves at least once (for rTP)."""
+        return {self._names[i] for i in np.flatnonzero(self.perceived).tolist() if i in self._names}
 
     def misperceived(self, names: Iterable[str]) -> dict[str, str]:
         """Of the world objects ``names``, those in view at some point but never perceived as themselves,
         with how: seen as another category's label, merged into a neighbour, or not detected."""
         by_name = {v: k for k, v in self._names.items()}
-        seen_as = {self._names[i]: lbl for i, lbl in self._labels.items() if i < FRAGMENT_BASE}
+        seen_as = {self._names[i]: lbl for i, lbl in self._labels.items() if i < self.fragments}
         out = {}
         for name in names:
             i = by_name.get(name)
             if i is None or not self.in_view[i] or self.perceived[i]:
                 continue
-            out[name] = (
-                f"seen as {seen_as[name]}"
-                if name in seen_as
-                else "merged into a neighbour"
-                if self.tables.merge[i]
-                else "not detected"
-            )
+            how = "merged into a neighbour" if self.tables.merge[i] else "not detected"
+            out[name] = f"seen as {seen_as[name]}" if name in seen_as else how
         return out
-
-
-def correctly_seen(perception: NoisyPerception | None, names: Mapping[int, str]) -> set[str]:
-    """World names among ``names`` (id -> name) that ``perception`` has perceived as themselves (all without it)."""
-    if perception is None:
-        return set(names.values())
-    return {n for i, n in names.items() if i < len(perception.perceived) and perception.perceived[i]}

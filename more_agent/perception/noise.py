@@ -16,9 +16,6 @@ from functools import cache
 
 import numpy as np
 
-FRAGMENT_BASE = 1 << 24
-"""Instance ids at and above this are fragments: ``FRAGMENT_BASE + i`` is the second half of instance ``i``."""
-
 TYPICAL_RANGE_M = 2.5
 """Range at which the miss rate is quoted."""
 TYPICAL_SIZE_M = 0.3
@@ -58,7 +55,8 @@ class Detections:
     semantic: np.ndarray
     """(H, W) semantic frame as perceived."""
     instance: np.ndarray
-    """(H, W) instance frame as perceived (fragments at ``FRAGMENT_BASE + i``)."""
+    """(H, W) instance frame as perceived; the second piece of a fragmented instance ``i`` is ``n + i``
+    (``n``: the length of the instance tables)."""
     whole: np.ndarray
     """(H, W) the same before fragmenting: each fragment under the id of its whole instance."""
     split: np.ndarray
@@ -188,7 +186,7 @@ def perturb_instances(
 
     Missed instances become unlabelled (semantic 0, instance 0: their depth stays, as an unknown
     obstacle); merged ones take their partner's id and class; a fragmented one's pixels right of its
-    centroid column take id ``FRAGMENT_BASE + i``; confused ones keep their id and show their episode's
+    centroid column take id ``n + i`` (``n`` instance ids in the tables); confused ones keep their id and show their episode's
     relative's class. Decisions are made per instance id (one draw each per frame, whatever is in view)
     and applied to the frames as look-ups of per-instance tables.
     """
@@ -217,7 +215,7 @@ def perturb_instances(
     pieces = whole
     if split.any():
         right = _columns(inst.shape) > np.where(split, centroid[:, 0], np.inf)[whole]
-        pieces = np.where(right, whole + FRAGMENT_BASE, whole).astype(instance.dtype, copy=False)
+        pieces = np.where(right, whole + n, whole).astype(instance.dtype, copy=False)
     return Detections(
         semantic=out_sem,
         instance=pieces,

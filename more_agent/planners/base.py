@@ -1,10 +1,13 @@
 """The planner protocol the episode runner drives, and the registry of planners by name.
 
 One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``HighLevelAction``, or
-``done``) and ``execute(action)`` (act: run it in the world, get an ``ActionResult``). The runner
-times the three phases, counts steps, reads the step's motion from the planner's robot
-(``body``), checks the goal and hands the planner's ``step_trace()`` to the episode folder; a
-planner never writes files, and never ends the episode itself except by deciding ``done``.
+``done``) and ``execute(action)`` (act: run it through the robot, get an ``ActionResult``). A planner
+is given a :class:`~more_agent.robot.Robot` and a :class:`~more_agent.goal.GoalSpec` and nothing else
+of the episode (:class:`EpisodeContext`); only a privileged planner (the oracle) is also granted the
+world and the goal checker (``grant``, with a ``more_agent.sim.goals.PrivilegedContext``). The runner
+times the three phases, counts steps, reads the step's motion from the robot, checks the goal and
+hands the planner's ``step_trace()`` to the episode folder; a planner never writes files, and never
+ends the episode itself except by deciding ``done``.
 Planners are built by name from the registry: ``make_planner('oracle')``. Built-in planners are
 listed by dotted path so that importing this module stays light; other code may add its own with
 ``register_planner``.
@@ -18,16 +21,13 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
 from more_agent.errors import UserError, unknown_name_error
+from more_agent.goal import GoalSpec
 from more_agent.records import DEFAULT_HISTORY, HistoryMode, LLMUsage
+from more_agent.robot import Robot
 
 if TYPE_CHECKING:
-    from more_agent.perception.model import NoisyPerception
-    from more_agent.planners.policies.embodiment import Embodiment
+    from more_agent.robot import ActionResult
     from more_agent.scene_graph import SceneGraph
-    from more_agent.sim.actions import ActionResult
-    from more_agent.sim.goals import GoalChecker
-    from more_agent.sim.instantiate import TaskInstance
-    from more_agent.sim.render import Frame
 
 DONE = "done"
 """Name of the action that ends an episode."""
@@ -69,23 +69,19 @@ class HighLevelAction:
 
 @dataclass(frozen=True)
 class EpisodeContext:
-    """What a planner is given at the start of an episode."""
+    """What a planner is given at the start of an episode: a robot and what it is told of its task."""
 
-    instance: TaskInstance
-    """The instantiated task; its ``world`` is the episode's world, changed by ``execute``."""
-    goals: GoalChecker
-    """Privileged goal access: only the oracle may read it (LLM planners get ``instance.description``)."""
+    robot: Robot
+    """The robot it drives: frames in, skills out."""
+    goal: GoalSpec
+    """The task's text; for a planner that reads the goal (``reads_goal``), its literals."""
     llm: str | None = None
     """LLM spec such as 'openai:gpt-4o', for planners that need one."""
     history: HistoryMode = DEFAULT_HISTORY
     """Which action history the LLM and VLM planners show (``more_agent.llm.prompts.history_text``)."""
-    on_frame: Callable[[Frame], None] | None = None
-    """Called with every frame the robot renders (the episode folder writes them with ``--save-frames``)."""
     trace_graphs: bool = False
     """Whether each step's trace must carry the scene graph (``--save-graph``, ``--viewer``): a planner
     that does not plan on one builds it only then."""
-    perception: NoisyPerception | None = None
-    """The episode's perception errors (``--perception noisy``), for the planner's robot; None: ground truth."""
 
 
 @dataclass(frozen=True)
@@ -102,13 +98,15 @@ class StepTrace:
 
 
 class Planner(Protocol):
-    """A high-level planner the episode runner drives step by step."""
+    """A high-level planner the episode runner drives step by step.
+
+    A planner whose class sets ``reads_goal = True`` (``grounded``) gets the goal's literals in
+    ``EpisodeContext.goal.goal``; the others get the task's text only.
+    """
 
     name: str
     llm: str | None
     """The LLM it plans with as a spec (e.g. 'openai:gpt-4o'); None for the oracle."""
-    body: Embodiment
-    """The robot it drives (set by ``reset``): its odometry gives each step's low-level steps and path."""
 
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode."""
@@ -124,9 +122,6 @@ class Planner(Protocol):
 
     def step_trace(self) -> StepTrace:
         """What the step just executed saw and decided."""
-
-    def observed_objects(self) -> set[str]:
-        """World object names the robot has observed so far this episode."""
 
     def llm_usage(self) -> LLMUsage:
         """LLM traffic of this episode so far."""

@@ -75,11 +75,9 @@ from more_agent.planners.vlm_prompts import (
     parse_verdict,
     step_messages,
 )
-from more_agent.records import DEFAULT_HISTORY, ActionRecord, HistoryMode, LLMUsage
+from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
+from more_agent.robot import XY, ActionResult, Frame
 from more_agent.scene_graph import SceneGraph
-from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.sim.navgrid import XY
-from more_agent.sim.render import Frame
 from more_agent.skills import INVALID
 
 log = logging.getLogger(__name__)
@@ -182,23 +180,15 @@ class BumblePlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer)."""
-        writer = context.on_frame
-        self.body = Embodiment(
-            context.instance.world,
-            config=self.config.policy,
-            mapping=self.config.mapping,
-            perception=context.perception,
-        )
+        self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping)
         self.memory = VisualMemory(self.config.memory)
 
         def on_frame(frame: Frame) -> None:
-            if writer is not None:
-                writer(frame)
             self.current = frame
             self.memory.offer(frame)
 
         self.body.on_frame = on_frame
-        self.task = context.instance.description
+        self.task = context.goal.text
         self.history, self.subtasks, self.feedback, self.history_mode = [], [], "", context.history
         self.calls.new_episode()
         self.body.sense()
@@ -251,10 +241,6 @@ class BumblePlanner:
             "buffer_frames": len(self.memory.frames),
         }
         return StepTrace(log=log_line, pictures=step.pictures)
-
-    def observed_objects(self) -> set[str]:
-        """World object names the robot has seen."""
-        return set(self.body.observed) if self.body is not None else set()
 
     def llm_usage(self) -> LLMUsage:
         """VLM traffic of this episode so far (images included), with the time spent waiting for answers."""

@@ -6,9 +6,7 @@ neither imports the other.
 
 from __future__ import annotations
 
-from more_agent.sim.goals import Literal
-from more_agent.sim.predicates import ROBOT_NAME
-from more_agent.sim.tasks import REARRANGE_PREDICATES
+from more_agent.goal import REARRANGE_PREDICATES, ROBOT_NAME, Literal
 
 ORACLE_PREDICATES = REARRANGE_PREDICATES
 """Goal predicates the oracle knows how to achieve: those of a rearrangement."""

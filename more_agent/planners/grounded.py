@@ -1,7 +1,7 @@
 """The ``grounded`` planner: an ideal reader of the goal, acting only through what the robot observes.
 
 It stands in for a language model that understands the task perfectly. It knows the task's goal in
-BDDL form and its description (:mod:`more_agent.planners.task_goal`), and the world only through
+BDDL form and its description (:class:`more_agent.goal.TaskGoal`, computed by the runner), and the world only through
 the same embodiment, scene graph and subpolicies as MORE: no world state, no object positions it
 has not seen, no goal checks. What it reaches is therefore the ceiling that perception, mapping,
 the scene graph and the subpolicies put on any language planner (``benchmarks/pipeline_ceiling.py``).
@@ -48,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from more_agent.goal import Literal, TaskGoal
 from more_agent.mapping import visible_unknown_area
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
@@ -55,14 +56,10 @@ from more_agent.planners.language import room_names
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
 from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type
-from more_agent.planners.task_goal import TaskGoal, task_goal
-from more_agent.records import LLMUsage
+from more_agent.records import FailureReason, LLMUsage
+from more_agent.robot import XY, ActionResult
 from more_agent.scene_graph import ObjectNode, SceneGraph
-from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.sim.catalog import can_hold_things
-from more_agent.sim.clutter import is_surface
-from more_agent.sim.goals import Literal
-from more_agent.sim.navgrid import XY
+from more_agent.sim.catalog import can_hold_things, is_surface
 from more_agent.vocabulary import FLOOR
 
 MAX_FAILURES = 2
@@ -112,6 +109,8 @@ class GroundedPlanner:
 
     name = "grounded"
     llm: str | None = None
+    reads_goal = True
+    """The runner hands it the goal's literals (``GoalSpec.goal``)."""
 
     def __init__(self, llm: str | None = None, *, config: PolicyConfig | None = None) -> None:
         del llm  # plans without a language model
@@ -120,10 +119,10 @@ class GroundedPlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Read the goal, start the robot with a full turn in place (paper S.3)."""
-        self.goal: TaskGoal = task_goal(context.instance, context.goals)
-        self.body = Embodiment(
-            context.instance.world, config=self.config, on_frame=context.on_frame, perception=context.perception
-        )
+        if context.goal.goal is None:
+            raise ValueError("the grounded planner reads the goal: its GoalSpec must carry the literals")
+        self.goal: TaskGoal = context.goal.goal
+        self.body = Embodiment(context.robot, config=self.config)
         option = self.goal.options[0]
         self.skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
         """Literals no subpolicy can achieve (named when the planner calls done)."""
@@ -196,10 +195,6 @@ class GroundedPlanner:
     def step_trace(self) -> StepTrace:
         """The scene graph the step planned on."""
         return StepTrace(graph=self.graph)
-
-    def observed_objects(self) -> set[str]:
-        """World object names the robot has seen."""
-        return set(self.body.observed)
 
     def llm_usage(self) -> LLMUsage:
         """No LLM."""
@@ -437,7 +432,7 @@ class GroundedPlanner:
         return scope not in self.goal.moved and bool(cats) and all(is_furniture(c) for c in cats)
 
     def _furniture_to_look_at(self, rooms: set[str]) -> str | None:
-        """The nearest furniture things are put on (tables, shelves, counters: ``sim.clutter.is_surface``)
+        """The nearest furniture things are put on (tables, shelves, counters: ``sim.catalog.is_surface``)
         of the task's ``rooms`` the robot has not been near (``LOOK_AT_M``): explore() clears a store's
         floor, but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
         if self.fruitless_looks >= FRUITLESS_EXPLORES:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import HighLevelAction
 from more_agent.records import ActionRecord
-from more_agent.sim.actions import ActionResult
+from more_agent.robot import ActionResult
 
 
 def append_action(history: list[ActionRecord], action: HighLevelAction, result: ActionResult) -> str:

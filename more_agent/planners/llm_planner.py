@@ -56,9 +56,9 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Area, Embodiment, PolicyConfig, pick_target, run_skill
 from more_agent.planners.policies.skills import without_visited_frontiers
-from more_agent.records import DEFAULT_HISTORY, ActionRecord, HistoryMode, LLMUsage
+from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
+from more_agent.robot import ActionResult
 from more_agent.scene_graph import SceneGraph
-from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.skills import INVALID, SKILLS, SKILLS_BY_NAME
 from more_agent.vocabulary import FLOOR, ROOM_TYPES
 
@@ -146,14 +146,8 @@ class LLMPlanner:
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
-        self.body = Embodiment(
-            context.instance.world,
-            config=self.config.policy,
-            mapping=self.config.mapping,
-            on_frame=context.on_frame,
-            perception=context.perception,
-        )
-        self.task = context.instance.description
+        self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping)
+        self.task = context.goal.text
         self.history, self.history_mode, self.feedback = [], context.history, ""
         self.calls.new_episode()
         self.body.sense()
@@ -217,10 +211,6 @@ class LLMPlanner:
             "exchanges": [e.to_json() for e in self.calls.exchanges],
         }
         return StepTrace(log=log_line, graph=self.graph)
-
-    def observed_objects(self) -> set[str]:
-        """World object names the robot has seen."""
-        return set(self.body.observed) if self.body is not None else set()
 
     def llm_usage(self) -> LLMUsage:
         """LLM traffic of this episode so far, with the time spent waiting for answers."""

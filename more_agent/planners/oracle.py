@@ -22,16 +22,17 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Collection
 
+from more_agent.goal import ROBOT_NAME, Literal
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.policies import Embodiment
-from more_agent.records import LLMUsage
+from more_agent.records import FailureReason, LLMUsage
+from more_agent.robot import ActionResult
 from more_agent.scene_graph import SceneGraph
-from more_agent.sim.actions import ActionResult, FailureReason, approach_rounds, distance_to_footprint
+from more_agent.sim.actions import approach_rounds, distance_to_footprint
 from more_agent.sim.env import ACTION_TYPES
-from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.goals import GoalChecker, PrivilegedContext, literal_holds
 from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
-from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.world import World, WorldObject
 from more_agent.skills import skill_named
 from more_agent.vocabulary import RELATIONS
@@ -94,7 +95,7 @@ def choose_option(goals: GoalChecker, world: World, exclude: Collection[int] = f
     def cost(i: int) -> tuple[int, int, int]:
         lits = goals.ground_literals(i)
         unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
-        unmet = sum(unsupported_reason(world, lit) is None and not lit.holds(world) for lit in lits)
+        unmet = sum(unsupported_reason(world, lit) is None and not literal_holds(world, lit) for lit in lits)
         return unsupported, unmet, i
 
     candidates = [i for i in range(goals.n_options) if i not in exclude]
@@ -110,11 +111,20 @@ class OraclePlanner:
 
     def __init__(self, llm: str | None = None) -> None:
         del llm
+        self._privileged: PrivilegedContext | None = None
+
+    def grant(self, privileged: PrivilegedContext) -> None:
+        """Receive the episode's world and goal checker (the runner calls it before ``reset``)."""
+        self._privileged = privileged
 
     def reset(self, context: EpisodeContext) -> None:
         """Choose the goal option and order its literals."""
-        self._world = context.instance.world
-        self._goals = context.goals
+        if self._privileged is None:
+            raise RuntimeError("the oracle plans from the world: grant() it a PrivilegedContext before reset()")
+        self._world = self._privileged.world
+        self._goals = self._privileged.goals
+        self._observed = self._privileged.observed
+        """Objects it acted on or revealed by opening (the runner adds them to what the camera saw)."""
         self._tried: set[int] = set()
         self._adopt_next_option()
         self._door: str | None = None
@@ -123,17 +133,11 @@ class OraclePlanner:
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_failure: dict[tuple[str, tuple[str, ...]], tuple[str, str | None]] = {}
         """Per action, the feedback and blocking door of its last failure."""
-        self._observed: set[str] = set()
-        self._body = Embodiment(context.instance.world, on_frame=context.on_frame, perception=context.perception)
+        self._body = Embodiment(context.robot)
         self._trace_graphs = context.trace_graphs
         self._graph: SceneGraph | None = None
         """The step's scene graph, built only for the trace (the oracle plans from the world)."""
         self._body.look_around()  # every trajectory starts with a full turn in place (paper S.3)
-
-    @property
-    def body(self) -> Embodiment:
-        """The robot the oracle drives."""
-        return self._body
 
     def _adopt_next_option(self) -> bool:
         """Work on the best ground option not tried yet; False when every option has been tried."""
@@ -158,10 +162,6 @@ class OraclePlanner:
         """The scene graph of what the camera saw, when the episode asked for graphs."""
         return StepTrace(graph=self._graph)
 
-    def observed_objects(self) -> set[str]:
-        """Objects the camera saw at each step, plus those the oracle acted on or revealed by opening."""
-        return self._observed | self._body.observed
-
     def llm_usage(self) -> LLMUsage:
         """The oracle uses no LLM."""
         return LLMUsage()
@@ -171,13 +171,13 @@ class OraclePlanner:
         """``done`` when the goal holds (or nothing more can be done), else the next subpolicy."""
         if self._goals.check(self._world).all_met:
             return HighLevelAction(DONE, note="all goal conditions hold")
-        pending = [lit for lit in self._literals if not lit.holds(self._world)]
+        pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         while not pending:
             # bddl's ground options can be partly infeasible (e.g. '(ontop log_1 log_1)'): the next may finish the job.
             explanation = self._explain_unmet()
             if not self._adopt_next_option():
                 return HighLevelAction(DONE, gave_up=explanation)
-            pending = [lit for lit in self._literals if not lit.holds(self._world)]
+            pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
@@ -317,12 +317,6 @@ class OraclePlanner:
 
     # -- acting -------------------------------------------------------------------------------
     def execute(self, action: HighLevelAction) -> ActionResult:
-        """Run a subpolicy through the magic actions; the robot's odometry counts their motion."""
-        result = self._run(action)
-        self._body.add_motion(result.path, result.low_level_steps)
-        return result
-
-    def _run(self, action: HighLevelAction) -> ActionResult:
         """Run a subpolicy as one magic action of the env; remember failures and blocking doors."""
         world = self._world
         result = self._body.act(world_action(action.name), *action.arguments)

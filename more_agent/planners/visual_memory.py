@@ -24,8 +24,8 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.llm.images import png_bytes
+from more_agent.robot import Frame
 from more_agent.sim.camera import project
-from more_agent.sim.render import Frame
 
 DEPTH_STRIDE = 4
 """Kept depth images are subsampled by this factor per axis (64x64 for 256x256 frames)."""

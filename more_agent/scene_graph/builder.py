@@ -24,9 +24,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from more_agent.mapping import OCCUPIED, MappingConfig, NavGraph, RegionGraph, VoxelMap, line_of_sight, region_graph
+from more_agent.robot import InstanceInfo
 from more_agent.scene_graph.model import (
     Box3D,
-    InstanceInfo,
     NavGraphData,
     ObjectNode,
     OccupancyMap,

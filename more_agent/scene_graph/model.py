@@ -55,21 +55,6 @@ class _Model(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
 
 
-class InstanceInfo(_Model):
-    """Ground-truth attributes of one instance id, filled by the simulator (the paper assumes
-    perfect instance segmentation and open/closed detection)."""
-
-    label: str = Field(description="Alphabetical instance label from the world, e.g. 'fridge A'.")
-    category: str = Field(description="Object category, e.g. 'fridge', 'door', 'apple'.")
-    open: bool | None = Field(default=None, description="Open state; None when not openable.")
-    held: bool = Field(default=False, description="True while the robot holds it.")
-    rests: tuple[vocabulary.Relation, str | None] | None = Field(
-        default=None,
-        description="How it rests as perceived: ('inside' | 'ontop', label of the container / support, None for "
-        "the floor). None when not reported: the builder then derives relations from box geometry.",
-    )
-
-
 class Box3D(_Model):
     """Axis-aligned box in world metres."""
 

@@ -19,14 +19,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from more_agent.records import FailureReason
-from more_agent.robot_spec import ROBOT
+from more_agent.robot import ActionResult
+from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT
 from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
-from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
 REACH_M = ROBOT.reach_m
@@ -46,23 +45,6 @@ RING_SPACING_M = 0.25
 
 FLOOR_POSE_SPACING_M = 0.5
 """Spacing of the candidate positions inside a room when navigating to its floor."""
-
-FORWARD_STEP_M = 0.075
-"""Length of one low-level forward move (paper S.3)."""
-
-MAX_TURN_RAD = math.radians(35)
-"""Largest low-level turn (paper S.3)."""
-
-
-@dataclass(frozen=True)
-class ActionResult(Outcome[FailureReason]):
-    """The outcome of one action: success, typed reason and feedback, and the motion it took."""
-
-    low_level_steps: int = 0
-    path: list[XY] = field(default_factory=list)
-    """Robot base positions visited, start and end included, when the robot moved."""
-    blocking: str | None = None
-    """The closed door in the way, when ``reason`` is PATH_BLOCKED_BY_DOOR."""
 
 
 def _ok(feedback: str, steps: int = 1, path: list[XY] | None = None) -> ActionResult:

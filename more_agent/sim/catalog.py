@@ -242,3 +242,44 @@ def furniture_role(category: str) -> str:
     if not big:
         return "skip"
     return "free" if category in FREE_STANDING_CATEGORIES else "floor"
+
+
+SURFACE_SYNSETS: frozenset[str] = frozenset(
+    {
+        "table.n.02",
+        "carrel.n.02",
+        "work_surface.n.01",
+        "shelf.n.01",
+        "bookcase.n.01",
+        "grocery_shelf.n.01",
+        "snack_rack.n.01",
+        "cabinet.n.01",
+        "bed.n.01",
+        "hospital_bed.n.02",
+        "sofa.n.01",
+        "bench.n.01",
+        "handcart.n.01",
+        "free_weight_rack.n.01",
+        "sink.n.01",
+        "stove.n.01",
+        "grill.n.02",
+    }
+)
+"""Furniture whose top things are put on, by bddl synset and its descendants: tables and desks
+(counters and office cubicles included), worktops, shelves, bookcases, cabinets, beds, sofas and
+benches, carts, weight racks, sinks (basin and rim) and cooktops (stoves, grills). Not monitors,
+lamps, plants, machines, bins, fixtures or the chairs one sits on: nobody leaves a keyboard on a
+monitor or a book on a range hood."""
+
+
+def descends_from(category: str, synsets: frozenset[str]) -> bool:
+    """Whether one of the category's synsets is one of ``synsets`` or descends from one."""
+    tax = taxonomy()
+    return any(synsets & {s, *tax.get_ancestors(s)} for s in category_synsets(category))
+
+
+@cache
+def is_surface(category: str) -> bool:
+    """Whether things are put on top of this furniture category (``SURFACE_SYNSETS``): tables,
+    counters, shelves; where distractors go and where a searching robot looks for small items."""
+    return descends_from(category, SURFACE_SYNSETS)

@@ -28,6 +28,7 @@ from functools import cache
 import numpy as np
 
 from more_agent.sim import catalog
+from more_agent.sim.catalog import is_surface
 from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.packing import support_surface
 from more_agent.sim.world import World, WorldObject, floor_name
@@ -51,33 +52,6 @@ MAX_SUPPORT_TOP_M = 2.0
 
 MIN_SUPPORT_TOP_M = 0.25
 """Furniture lower than this (mats, low platforms) is not used as a surface."""
-
-SURFACE_SYNSETS: frozenset[str] = frozenset(
-    {
-        "table.n.02",
-        "carrel.n.02",
-        "work_surface.n.01",
-        "shelf.n.01",
-        "bookcase.n.01",
-        "grocery_shelf.n.01",
-        "snack_rack.n.01",
-        "cabinet.n.01",
-        "bed.n.01",
-        "hospital_bed.n.02",
-        "sofa.n.01",
-        "bench.n.01",
-        "handcart.n.01",
-        "free_weight_rack.n.01",
-        "sink.n.01",
-        "stove.n.01",
-        "grill.n.02",
-    }
-)
-"""Furniture whose top things are put on, by bddl synset and its descendants: tables and desks
-(counters and office cubicles included), worktops, shelves, bookcases, cabinets, beds, sofas and
-benches, carts, weight racks, sinks (basin and rim) and cooktops (stoves, grills). Not monitors,
-lamps, plants, machines, bins, fixtures or the chairs one sits on: nobody leaves a keyboard on a
-monitor or a book on a range hood."""
 
 CONTAINER_SYNSETS: frozenset[str] = frozenset({"cabinet.n.01", "cabinet.n.03", "refrigerator.n.01", "box.n.01"})
 """Openable furniture things are stored inside: cabinets, lockers, fridges, boxes (cartons); not
@@ -138,20 +112,9 @@ def _scale_to(total: int, counts: dict[str, int]) -> dict[str, int]:
 
 
 @cache
-def is_surface(category: str) -> bool:
-    """Whether distractors are put on top of this furniture category (``SURFACE_SYNSETS``)."""
-    return _descends_from(category, SURFACE_SYNSETS)
-
-
-@cache
 def is_storage(category: str) -> bool:
     """Whether distractors are stored inside this (openable) furniture category (``CONTAINER_SYNSETS``)."""
-    return _descends_from(category, CONTAINER_SYNSETS)
-
-
-def _descends_from(category: str, synsets: frozenset[str]) -> bool:
-    tax = catalog.taxonomy()
-    return any(synsets & {s, *tax.get_ancestors(s)} for s in catalog.category_synsets(category))
+    return catalog.descends_from(category, CONTAINER_SYNSETS)
 
 
 def _is_loose(category: str) -> bool:

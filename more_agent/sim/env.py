@@ -36,19 +36,27 @@ path of a magic navigation, the closed door that blocked it (``blocking``) and t
 of the view. Goal state is privileged: only an
 env built with ``privileged_info=True`` adds ``info["goal_status"]`` (a ``GoalStatus``: per-conjunct
 status, ``all_met``, ``progress``), for evaluation code and tests, never for a planner under test.
+
+:class:`SimRobot` is the :class:`~more_agent.robot.Robot` the simulator offers a planner: it steps
+this env without sensors (every low-level move and magic action one ``env.step``), renders with the
+robot's own camera when the planner senses, and keeps the robot's odometry, which the episode runner
+reads for each step's motion.
 """
 
 from __future__ import annotations
 
 import math
 import string
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from more_agent.records import FailureReason
+from more_agent.robot import XY, ActionResult, InstanceInfo, Observation
+from more_agent.robot_spec import full_turn_angles
 from more_agent.sim import actions, motion
 from more_agent.sim.camera import Camera
 from more_agent.sim.goals import GoalChecker, GoalStatus
@@ -56,8 +64,9 @@ from more_agent.sim.instantiate import TaskInstance, instantiate
 from more_agent.sim.navgrid import free_cells, nav_grid
 from more_agent.sim.render import Frame, Renderer, instance_table
 from more_agent.sim.scenes import get_scene
-from more_agent.sim.world import World
+from more_agent.sim.world import World, floor_name
 from more_agent.skills import SKILLS
+from more_agent.vocabulary import Relation
 
 ENV_ID = "MoreAgent/Behavior-v0"
 
@@ -304,7 +313,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         start = self.world.robot
         x, y, yaw = start.x, start.y, start.yaw
         turn_frames = [self._record()]
-        angles = motion.full_turn_angles()
+        angles = full_turn_angles()
         for angle in angles[:-1]:
             motion.turn(self.world, angle)
             turn_frames.append(self._record())
@@ -384,6 +393,160 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         if self.privileged_info:
             info["goal_status"] = status
         return info
+
+
+class SimRobot:
+    """The robot of a simulated episode as a planner drives it (:class:`~more_agent.robot.Robot`).
+
+    Built by the episode runner on the episode's world; the world, the env and the renderer are its
+    own and private. Perception is ground truth as in the paper (S.2): instance attributes, open state
+    and how an object rests (inside / on top of what) are read from the world for the instances in
+    view. ``observed`` (world names of everything seen) is for the runner's rTP metric.
+    """
+
+    def __init__(
+        self, world: World, *, renderer: Renderer | None = None, on_frame: Callable[[Frame], None] | None = None
+    ) -> None:
+        """``on_frame`` is called with every rendered frame (the episode folder writes them)."""
+        self._world = world
+        self._env = MoreAgentEnv(sensors=False, max_steps=None)
+        self._env.reset(options={"world": world})
+        self._renderer = renderer or Renderer()
+        self._on_frame = on_frame
+        self._held: str | None = None
+        """The held item at the last sensing (to report one released since)."""
+        self._steps = 0
+        self._trajectory: list[XY] = [self.pose[:2]]
+        self._reported_steps, self._reported_path = 0, 1
+        self.observed: set[str] = set()
+        """World names of every object seen so far."""
+
+    @property
+    def class_names(self) -> Sequence[str]:
+        return self._world.class_names
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        r = self._world.robot
+        return float(r.x), float(r.y), float(r.yaw)
+
+    @property
+    def held(self) -> int | None:
+        name = self._world.robot.held
+        return None if name is None else self._world.objects[name].instance_id
+
+    @property
+    def trajectory(self) -> Sequence[XY]:
+        return self._trajectory
+
+    @property
+    def low_level_steps(self) -> int:
+        return self._steps
+
+    def sense(self, acted_on: Sequence[str] = ()) -> Observation:
+        """Render a frame from the current pose with what perception says of it.
+
+        The robot knows what it did: an item released since the last frame is reported as no longer
+        held, resting where it was put, even when no camera sees it (``Observation.placed`` keeps it,
+        and what rode on or in it, at their boxes), and the objects in ``acted_on`` are reported with
+        their new state even when out of view.
+        """
+        world = self._world
+        frame = self._renderer.render(world)
+        if self._on_frame is not None:
+            self._on_frame(frame)
+        table = instance_table(world, frame.instance)
+        infos = {
+            i: InstanceInfo(
+                label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
+            )
+            for i, d in table.items()
+        }
+        released = self._held if self._held is not None and self._held != world.robot.held else None
+        acted = [name for name in map(self._env.resolve, acted_on) if name is not None]
+        for name in [*acted, *([released] if released is not None else [])]:
+            obj = world.get(name)
+            infos.setdefault(
+                obj.instance_id,
+                InstanceInfo(
+                    label=obj.label,
+                    category=obj.category,
+                    open=obj.is_open if obj.openable else None,
+                    held=world.robot.held == name,
+                    rests=self._rests(name),
+                ),
+            )
+        placed = {}
+        if released is not None:  # with what rode on it
+            placed = {obj.instance_id: obj.box() for obj in [world.get(released), *world.descendants(released)]}
+        self._held = world.robot.held
+        self.observed.update(d["name"] for d in table.values())
+        return Observation(frame=frame, instances=infos, placed=placed)
+
+    def _rests(self, name: str) -> tuple[Relation, str | None] | None:
+        """How a seen object rests, as perception reports it: the world's support link (what the last
+        placement did), the support named by its label (None for a floor); None while held."""
+        obj = self._world.get(name)
+        if obj.parent is None or obj.relation is None:
+            return None if self._world.robot.held == name else ("ontop", None)
+        parent = self._world.get(obj.parent)
+        return obj.relation, parent.label if parent.kind != "floor" else None
+
+    def move_forward(self, distance: float) -> bool:
+        ok = bool(self._step("move_forward", amount=distance)["action_ok"])
+        self._steps += 1
+        if ok:
+            self._trajectory.append(self.pose[:2])
+        return ok
+
+    def turn(self, angle: float) -> None:
+        self._step("turn_left" if angle >= 0 else "turn_right", amount=abs(angle))
+        self._steps += 1
+
+    def act(self, action: str, target: str = "") -> ActionResult:
+        """One magic action of the env on ``target`` (a world name or label); its motion joins the odometry."""
+        info = self._step(action, target=target)
+        result = ActionResult(
+            ok=info["action_ok"],
+            reason=FailureReason(info["reason"]) if info["reason"] else None,
+            feedback=info["feedback"],
+            low_level_steps=info["low_level_steps"],
+            path=info["path"],
+            blocking=info["blocking"],
+        )
+        self._steps += result.low_level_steps
+        self._trajectory.extend((float(x), float(y)) for x, y in result.path[1:])
+        return result
+
+    def reach_distance(self, target: str) -> float | None:
+        name = self._env.resolve(target)
+        return None if name is None else actions.distance_to_footprint(self._world, name)
+
+    def floor_here(self) -> str | None:
+        room = self._world.room_at(*self.pose[:2])
+        return None if room is None else floor_name(room)
+
+    def since_last_report(self, result: ActionResult) -> ActionResult:
+        """``result`` with the low-level steps and path the robot made since the previous call (the first
+        call's include the initial full turn): what one high-level step reports to the episode loop."""
+        steps, self._reported_steps = self._steps - self._reported_steps, self._steps
+        path = self._trajectory[self._reported_path - 1 :] if len(self._trajectory) > self._reported_path else []
+        self._reported_path = len(self._trajectory)
+        return ActionResult(
+            ok=result.ok,
+            reason=result.reason,
+            feedback=result.feedback,
+            low_level_steps=steps,
+            path=path,
+            blocking=result.blocking,
+        )
+
+    def _step(self, kind: str, *, target: str = "", amount: float | None = None) -> dict[str, Any]:
+        """``env.step`` of action type ``kind`` (:data:`ACTION_TYPES`); its info."""
+        action: dict[str, object] = {"type": ACTION_TYPES.index(kind), "target": target}
+        if amount is not None:
+            action["amount"] = amount  # a Python float: the env keeps its full precision
+        return self._env.step(action)[-1]
 
 
 def _parse(action: Any) -> tuple[str | None, float, str, str | None]:

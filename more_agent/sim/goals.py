@@ -11,13 +11,14 @@ progress (TP). The oracle reads the same option as structured ``Literal``s.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_ground_goal_state_options
 from bddl.condition_evaluation import evaluate_state
 
 from more_agent.errors import UserError
+from more_agent.goal import Literal
 from more_agent.records import GoalCondition
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.predicates import holds
@@ -27,23 +28,9 @@ if TYPE_CHECKING:
     from more_agent.sim.instantiate import TaskInstance
 
 
-@dataclass(frozen=True)
-class Literal:
-    """One ground goal literal over world object names ('robot' for the agent)."""
-
-    predicate: str
-    args: tuple[str, ...]
-    negated: bool = False
-
-    @property
-    def text(self) -> str:
-        """BDDL form with world names, e.g. '(inside apple_1 fridge_0)' or '(not (open fridge_0))'."""
-        atom = f"({' '.join((self.predicate, *self.args))})"
-        return f"(not {atom})" if self.negated else atom
-
-    def holds(self, world: World) -> bool:
-        """Whether the literal holds in ``world``: the predicates bddl evaluates (``sim.predicates``)."""
-        return holds(world, self.predicate, self.args) != self.negated
+def literal_holds(world: World, lit: Literal) -> bool:
+    """Whether ``lit`` (over world names) holds in ``world``: the predicates bddl evaluates (``sim.predicates``)."""
+    return holds(world, lit.predicate, lit.args) != lit.negated
 
 
 @dataclass(frozen=True)
@@ -76,7 +63,7 @@ class GoalChecker:
     """Evaluates one task instance's goal on a world (the instance's own, or another of the same task)."""
 
     def __init__(self, instance: TaskInstance, goal: list[Any] | None = None) -> None:
-        """``goal`` replaces the task's parsed goal (a reading of it, ``planners.task_goal``)."""
+        """``goal`` replaces the task's parsed goal (a reading of it, ``sim.task_goal``)."""
         self.backend = WorldBackend(instance.world)
         self.scope = instance.scope_objects()
         conds = instance.definition.conditions
@@ -129,3 +116,14 @@ class GoalChecker:
             conditions=conditions,
             option_index=best_index,
         )
+
+
+@dataclass(frozen=True)
+class PrivilegedContext:
+    """What only a privileged planner (the oracle) is given, besides its robot: the episode's world and
+    its goal checker. ``observed`` collects world names it counts as observed beyond what its camera
+    saw (what it acted on, what opening revealed), for the rTP metric."""
+
+    world: World
+    goals: GoalChecker
+    observed: set[str] = field(default_factory=set)

@@ -19,9 +19,9 @@ from enum import Enum
 
 import numpy as np
 
-from more_agent.sim.actions import FORWARD_STEP_M, MAX_TURN_RAD
+from more_agent.robot import Outcome
+from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD
 from more_agent.sim.navgrid import DEFAULT_NAV, NavConfig
-from more_agent.sim.outcome import Outcome
 from more_agent.sim.world import World, WorldObject
 
 _TOLERANCE = 1e-6
@@ -117,9 +117,3 @@ def turn(world: World, angle: float) -> MotionResult:
     world.set_robot_pose(r.x, r.y, r.yaw + applied)
     side = "left" if applied >= 0 else "right"
     return MotionResult(True, None, f"turned {side} {abs(math.degrees(applied)):.1f} deg{note}", applied)
-
-
-def full_turn_angles(max_turn: float = MAX_TURN_RAD) -> list[float]:
-    """Equal left turns of at most ``max_turn`` that add up to one full turn (11 of 32.7 deg for 35 deg)."""
-    n = math.ceil(2 * math.pi / max_turn - 1e-9)
-    return [2 * math.pi / n] * n

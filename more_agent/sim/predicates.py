@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from more_agent.goal import ROBOT_NAME
 from more_agent.sim.world import World, WorldObject, floor_name
 
 NEXTTO_GAP_M = 0.3
@@ -32,9 +33,6 @@ NEXTTO_GAP_M = 0.3
 
 TOUCH_GAP_M = 0.02
 """Largest gap between two boxes that still counts as touching."""
-
-ROBOT_NAME = "robot"
-"""World name the agent scope (``agent.n.01_1``) stands for."""
 
 
 def is_open(world: World, name: str) -> bool:

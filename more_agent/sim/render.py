@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from more_agent.robot import Frame
 from more_agent.sim.camera import Camera
 from more_agent.sim.grid import Grid
 from more_agent.sim.packing import SLAB_FRACTION
@@ -61,20 +62,6 @@ _STRUCTURAL_COLORS: dict[str, tuple[int, int, int]] = {
     "door": (140, 90, 50),
     "window": (150, 200, 230),
 }
-
-
-@dataclass(frozen=True, eq=False)
-class Frame:
-    """One camera frame. depth: (H, W) float32 z-depth in metres, NaN where invalid (nothing hit or
-    beyond range); semantic / instance: (H, W) int32 (0 = unlabelled / none); rgb: (H, W, 3) uint8;
-    K: (3, 3) intrinsics; T_world_cam: (4, 4) camera-to-world pose (OpenCV camera axes)."""
-
-    rgb: np.ndarray
-    depth: np.ndarray
-    semantic: np.ndarray
-    instance: np.ndarray
-    K: np.ndarray
-    T_world_cam: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)

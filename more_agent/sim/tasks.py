@@ -27,11 +27,9 @@ from typing import Any
 import numpy as np
 
 from more_agent.errors import UserError, unknown_name_error
+from more_agent.goal import REARRANGE_PREDICATES
 from more_agent.sim import catalog
 from more_agent.sim.matching import maximum_matching
-
-REARRANGE_PREDICATES = frozenset({"inside", "ontop", "open"})
-"""Goal predicates of the behavior-rearrange set."""
 
 TASK_SETS: tuple[str, ...] = ("more-paper", "behavior-rearrange")
 

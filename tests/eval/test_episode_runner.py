@@ -12,9 +12,8 @@ from more_agent.eval.metrics import rtp
 from more_agent.eval.store import RunConfig
 from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.oracle import OraclePlanner
-from more_agent.planners.policies import Embodiment
 from more_agent.records import EpisodeRecord, EpisodeSpec, LLMUsage
-from more_agent.sim.actions import ActionResult
+from more_agent.robot import ActionResult
 
 SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
 
@@ -63,7 +62,7 @@ class _Idle:
     llm = None
 
     def reset(self, context: EpisodeContext) -> None:
-        self.body = Embodiment(context.instance.world)
+        pass
 
     def observe(self) -> None:
         pass
@@ -76,9 +75,6 @@ class _Idle:
 
     def step_trace(self) -> StepTrace:
         return StepTrace()
-
-    def observed_objects(self) -> set[str]:
-        return set()
 
     def llm_usage(self) -> LLMUsage:
         return LLMUsage()

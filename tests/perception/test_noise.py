@@ -7,7 +7,6 @@ import pytest
 
 from more_agent.errors import UserError
 from more_agent.perception.noise import (
-    FRAGMENT_BASE,
     DepthNoise,
     InstanceTables,
     drift_step,
@@ -120,8 +119,8 @@ def test_confusion_fragmentation_and_merging() -> None:
     found = perturb_instances(depth, semantic, instance, 32.0, t, 0.0, np.random.default_rng(0))
     sem, inst = found.semantic, found.instance
     assert (sem[instance == 1] == 6).all()  # seen as its sibling's class, same instance ...
-    assert set(np.unique(inst[instance == 1])) == {1, 1 + FRAGMENT_BASE}  # ... in two pieces, split at its middle
-    left, right = np.nonzero(inst == 1)[1], np.nonzero(inst == 1 + FRAGMENT_BASE)[1]
+    assert set(np.unique(inst[instance == 1])) == {1, 1 + 4}  # ... in two pieces, split at its middle
+    left, right = np.nonzero(inst == 1)[1], np.nonzero(inst == 1 + 4)[1]
     assert left.max() < right.min() and abs(len(left) - len(right)) <= 0.2 * len(left)  # split near its middle column
     found = perturb_instances(
         depth, semantic, instance, 32.0, tables(merge=[False, False, True, False]), 0.0, np.random.default_rng(0)

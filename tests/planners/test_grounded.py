@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from more_agent.eval.episode import run_episode
-from more_agent.planners.base import EpisodeContext, HighLevelAction, default_planner, make_planner
+from more_agent.eval.episode import reset_planner, run_episode
+from more_agent.planners.base import HighLevelAction, default_planner, make_planner
 from more_agent.planners.grounded import (
     FLOOR,
     FRUITLESS_EXPLORES,
@@ -19,14 +19,14 @@ from more_agent.planners.grounded import (
     far_frontiers,
 )
 from more_agent.planners.room_types import is_furniture, likely_room_type
-from more_agent.planners.task_goal import intended_goal, task_goal
-from more_agent.records import EpisodeSpec
+from more_agent.records import EpisodeSpec, FailureReason
+from more_agent.robot import ActionResult
 from more_agent.scene_graph import RegionNode
-from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
 from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
 from more_agent.sim.scene import load_scene
+from more_agent.sim.task_goal import intended_goal, task_goal
 from more_agent.sim.world import World
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
@@ -47,7 +47,7 @@ def fresh_kitchen() -> TaskInstance:
 def planner_in(kitchen: TaskInstance) -> GroundedPlanner:
     """A grounded planner reset in ``kitchen`` (the goal checker refuses to be asked) after its first observation."""
     planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    reset_planner(planner, kitchen, BlindGoals(kitchen))
     planner.observe()
     return planner
 
@@ -81,7 +81,7 @@ def test_a_forall_whose_body_names_one_scope_is_read_over_its_variable() -> None
 
 def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: TaskInstance) -> None:
     planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    reset_planner(planner, kitchen, BlindGoals(kitchen))
     actions = []
     for _ in range(50):
         planner.observe()
@@ -125,12 +125,11 @@ def test_explore_goes_to_the_frontiers_with_the_most_unseen_floor_in_range() -> 
     import numpy as np
 
     from more_agent.mapping import FREE, UNKNOWN
-    from more_agent.planners.base import EpisodeContext
     from more_agent.scene_graph import OccupancyMap
 
     kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
     planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    reset_planner(planner, kitchen, BlindGoals(kitchen))
     planner.observe()
     cells = np.full((400, 200), FREE, dtype=np.int8)  # 40 m x 20 m at 0.1 m, corner at the origin
     cells[300:, :] = UNKNOWN  # a large unseen area east of x = 30 m
@@ -171,7 +170,7 @@ def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
 
 def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
     planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    reset_planner(planner, kitchen, BlindGoals(kitchen))
     planner.observe()
     scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
     label = planner.bound[scope]
@@ -186,7 +185,7 @@ def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInst
 
 def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
     planner = GroundedPlanner()
-    planner.reset(EpisodeContext(instance=kitchen, goals=BlindGoals(kitchen)))
+    reset_planner(planner, kitchen, BlindGoals(kitchen))
     planner.observe()
     fridge = planner.seen["fridge A"]
     assert fridge.bbox.min[2] <= GROUND_M and _on_floor(planner.relation["fridge A"])  # it stands on the floor

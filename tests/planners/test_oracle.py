@@ -7,11 +7,13 @@ from types import SimpleNamespace
 
 from bddl.activity import Conditions
 
+from more_agent.goal import GoalSpec
 from more_agent.planners.base import EpisodeContext, make_planner
 from more_agent.planners.goal_order import order_literals
 from more_agent.planners.oracle import OraclePlanner, merge_placements
 from more_agent.sim.bddl_backend import ScopeObject
-from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.env import SimRobot
+from more_agent.sim.goals import GoalChecker, Literal, PrivilegedContext
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.world import World
 from tests.sim.test_navgrid import two_room_world
@@ -52,7 +54,8 @@ def bddl_goals(world: World, goal: list[Literal]) -> GoalChecker:
 
 def solve(world: World, goals: GoalChecker, max_steps: int = 50) -> tuple[list[tuple[str, tuple[str, ...], bool]], str]:
     planner = OraclePlanner()
-    planner.reset(EpisodeContext(instance=SimpleNamespace(world=world), goals=goals))  # type: ignore[arg-type]
+    planner.grant(PrivilegedContext(world=world, goals=goals))
+    planner.reset(EpisodeContext(robot=SimRobot(world), goal=GoalSpec(text="")))
     log = []
     for _ in range(max_steps):
         planner.observe()

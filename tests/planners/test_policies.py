@@ -19,8 +19,9 @@ from more_agent.planners.policies import (
     pick_target,
 )
 from more_agent.planners.policies.skills import place_on_floor
+from more_agent.records import FailureReason
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
-from more_agent.sim.actions import FailureReason
+from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 
@@ -30,7 +31,7 @@ KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 def fresh() -> tuple[TaskInstance, Embodiment, SceneGraph]:
     """A kitchen task instance after the initial full turn, and its scene graph (the robot starts in the kitchen)."""
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
-    body = Embodiment(inst.world)
+    body = Embodiment(SimRobot(inst.world))
     body.look_around()
     return inst, body, body.build()
 
@@ -54,7 +55,7 @@ def looked_around() -> tuple[TaskInstance, Embodiment, SceneGraph]:
 def test_look_around_is_a_full_turn_of_low_level_steps(looked_around: tuple[TaskInstance, Embodiment, SceneGraph]) -> None:
     inst, body, graph = looked_around
     assert body.low_level_steps == 11  # 360 deg in turns of at most 35 deg
-    assert graph.objects and "fridge A" in graph.objects and "fridge_0" in body.observed
+    assert graph.objects and "fridge A" in graph.objects and inst.world.get("fridge_0").instance_id in body.observed
     assert graph.robot.region_id in graph.regions
 
 

@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from more_agent.eval.episode import run_episode
+from more_agent.eval.episode import reset_planner, run_episode
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.prompts import HISTORY_LAST_N, LASTING_SKILLS
-from more_agent.planners.base import EpisodeContext, HighLevelAction
+from more_agent.planners.base import HighLevelAction
 from more_agent.planners.language import FLOOR, HELD, SceneView, room_names
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.records import ActionRecord, EpisodeSpec, HistoryMode
@@ -293,7 +293,7 @@ def test_the_history_option_reaches_the_plan_prompt(history: HistoryMode) -> Non
     client = ScriptedClient(brain)
     agent = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, "scripted"))
     instance = instantiate_in_scene(TASK, load_scene(TINY), seed=0)
-    agent.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance), history=history))
+    reset_planner(agent, instance, GoalChecker(instance), history=history)
     old = [
         ActionRecord(step=0, name="go_to_and_grasp", arguments=["kitchen_0", "apple A"], ok=True, feedback="grasped apple A"),
         ActionRecord(step=1, name="explore", arguments=["kitchen_0"], ok=False, feedback="no unexplored area"),

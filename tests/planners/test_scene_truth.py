@@ -11,6 +11,7 @@ import pytest
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.policies import Embodiment, go_to_and
 from more_agent.sim import catalog
+from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import free_floor_spot, instantiate_in_scene
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World, WorldObject
@@ -65,17 +66,17 @@ def _truth(world: World, name: str) -> tuple[str, str] | None:
     return ("inside" if obj.relation == "inside" else "on top of", world.get(obj.parent).label)
 
 
-def _act(body: Embodiment, verb: str, name: str) -> None:
+def _act(body: Embodiment, world: World, verb: str, name: str) -> None:
     """Drive there on the agent's map and act, as the planners do."""
     graph = body.build()
-    result = go_to_and(body, graph, verb, graph.objects[body.world.get(name).label])
+    result = go_to_and(body, graph, verb, graph.objects[world.get(name).label])
     assert result.ok, f"{verb} {name}: {result.feedback}"
 
 
 def _shuffle(world: World, rng: np.random.Generator, check: bool = True) -> tuple[int, int]:
     """Eight random grasp-and-place rounds (opening the car when needed, closing it at random); with
     ``check``, the scene text is compared with the world after each. Returns (placements, closes)."""
-    body = Embodiment(world)
+    body = Embodiment(SimRobot(world))
     body.look_around()
     items = [o.name for o in world.items() if o.category in ITEMS]
     moved: set[str] = set()
@@ -87,15 +88,15 @@ def _shuffle(world: World, rng: np.random.Generator, check: bool = True) -> tupl
         if world.get(container).label not in seen:
             continue
         if not world.get("car_t").is_open:
-            _act(body, "open", "car_t")
+            _act(body, world, "open", "car_t")
         if world.enclosing_closed_container(item) is not None:
             continue
-        _act(body, "grasp", item)
-        _act(body, f"place_{CONTAINERS[container.removesuffix('_t')]}", container)
+        _act(body, world, "grasp", item)
+        _act(body, world, f"place_{CONTAINERS[container.removesuffix('_t')]}", container)
         moved.add(item)
         placements += 1
         if rng.random() < 0.4:
-            _act(body, "close", "car_t")
+            _act(body, world, "close", "car_t")
             closed += 1
         if not check:
             continue
@@ -131,12 +132,12 @@ def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_ope
     room (not left behind, not an obstacle where the robot stands), and in the bag again where it is
     put down. The door the robot opened stays in the text, open, even when no frame shows it."""
     world = instantiate_in_scene("store_produce", load_scene(TINY), seed=0, distractors=False).world
-    body = Embodiment(world)
+    body = Embodiment(SimRobot(world))
     body.look_around()
     bag = world.get("sack_1").label
     fruit = sorted(world.get(d.name).label for d in world.descendants("sack_1"))
-    _act(body, "open", "door_0")
-    _act(body, "grasp", "sack_1")
+    _act(body, world, "open", "door_0")
+    _act(body, world, "grasp", "sack_1")
     graph = body.build()
     view = scene_view(graph, LanguageOptions())
     robot_room = view.room(view.robot_room)
@@ -144,7 +145,7 @@ def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_ope
     assert all(_shown(view, f)[1] == ("inside", bag) and f in {o.name for o in robot_room.objects} for f in fruit), view.text()
     cell = graph.occupancy.frame.cell_of(np.array([body.xy]))[0]
     assert graph.occupancy.grid[cell[0], cell[1]] != 2, "what the robot carries maps as an obstacle where it stands"
-    _act(body, "place_ontop", "breakfast_table_0")
+    _act(body, world, "place_ontop", "breakfast_table_0")
     body.face((body.xy[0] - 5.0, body.xy[1]))  # look away from the door and the table
     view = scene_view(body.build(), LanguageOptions())
     assert _shown(view, bag)[1] == ("on top of", world.get("breakfast_table_0").label)

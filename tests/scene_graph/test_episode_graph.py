@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections import Counter
 
 from more_agent.planners.policies import Embodiment
+from more_agent.sim.env import SimRobot
 from more_agent.sim.navgrid import nav_grid
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.world import World
@@ -20,7 +21,7 @@ def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> Non
     for door in world.scene.doors:
         world.set_open(door.id, True)
     grid = nav_grid(world)
-    body = Embodiment(world)
+    body = Embodiment(SimRobot(world))
     centres = [((r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2) for r in world.scene.rooms]
     doors = [((d.bounds()[0] + d.bounds()[2]) / 2, (d.bounds()[1] + d.bounds()[3]) / 2) for d in world.scene.doors]
     for x, y in centres + doors:  # as a robot driving from room to room sees them: the doors it passes too

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from more_agent.sim.motion import MotionFailure, clearance, full_turn_angles, move_forward, obstacle_boxes, turn
+from more_agent.robot_spec import full_turn_angles
+from more_agent.sim.motion import MotionFailure, clearance, move_forward, obstacle_boxes, turn
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall
 from more_agent.sim.world import World, WorldObject
 

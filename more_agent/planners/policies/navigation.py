@@ -8,7 +8,7 @@ without them the robot's own spot is a hole that cuts it off from the map it has
 occupied since: a magic action's final approach drives on the ground truth with the robot's real radius
 and may leave it inside the inflation margin of its map (a gap between a counter and a table), where no
 path with the full margin leads out. Shortest paths use the same
-8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.navgrid.shortest_path`,
+8-connected geometric search as the ground-truth grid (:func:`more_agent.sim.paths.shortest_path`,
 an optimal search like A* with an admissible heuristic), here on what the agent knows.
 """
 
@@ -22,8 +22,9 @@ import numpy as np
 from scipy import ndimage
 
 from more_agent.mapping import FREE, OCCUPIED
+from more_agent.robot import XY
 from more_agent.scene_graph import OccupancyMap, SceneGraph
-from more_agent.sim.navgrid import XY, NavGrid, PathResult, shortest_path
+from more_agent.sim.paths import NavGrid, PathResult, shortest_path
 
 
 def agent_nav_grid(

@@ -2,7 +2,7 @@
 
 Each takes the scene graph of the current step and the names the planner used, drives the robot
 with low-level moves on the agent's own map (fusing the frames it sees on the way) and returns an
-:class:`~more_agent.sim.actions.ActionResult` whose ``feedback`` is what the planner reads next:
+:class:`~more_agent.robot.ActionResult` whose ``feedback`` is what the planner reads next:
 a success flag plus a simple reason ("hand is full", "must open fridge A first", "no frontier left
 in kitchen_0", "unknown object"). ``go_to_and_<verb>`` drives to the Voronoi node closest to the
 object, then runs the magic action on the world object the label resolves to; that action makes
@@ -20,11 +20,11 @@ from dataclasses import dataclass
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
+from more_agent.records import FailureReason
+from more_agent.robot import XY, ActionResult
+from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
-from more_agent.sim import actions
-from more_agent.sim.actions import ActionResult, FailureReason
-from more_agent.sim.navgrid import XY, PathResult
-from more_agent.sim.world import floor_name
+from more_agent.sim.paths import PathResult
 from more_agent.skills import Skill, Subpolicy, skill_named
 
 
@@ -108,7 +108,7 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
     """Drive to the Voronoi node closest to the object on the agent's map, then face it. When that node
     lies in a part of the map the robot cannot drive to (a gap narrower than its clearance, unknown
     cells between), drive instead to the reachable spot closest to the object within arm's reach
-    (``actions.REACH_M``) of its centre."""
+    (``ROBOT.reach_m``) of its centre."""
     start = body.low_level_steps
     if target.held:
         return _fail(FailureReason.INVALID_TARGET, f"already holding {target.label}")
@@ -117,7 +117,7 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: no map yet")
     reached, index, why = _drive(body, graph, [goal])
     if index is None:  # the node is off the robot's part of the map: any spot within arm's reach will do
-        reached, _, why = _drive(body, graph, [target.position[:2]], snap_m=actions.REACH_M)
+        reached, _, why = _drive(body, graph, [target.position[:2]], snap_m=ROBOT.reach_m)
     if not reached:
         return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {target.label}: {why}", body.low_level_steps - start)
     body.face(target.position[:2])
@@ -129,17 +129,17 @@ def navigate(body: Embodiment, graph: SceneGraph, target: ObjectNode) -> ActionR
 def go_to_and(body: Embodiment, graph: SceneGraph, verb: str, target: ObjectNode) -> ActionResult:
     """navigate() unless the object is within reach, then the magic action on the world object."""
     start = body.low_level_steps
-    name = body.resolve(target.label)
-    if name is None:
+    distance = body.robot.reach_distance(target.label)
+    if distance is None:
         return _fail(FailureReason.UNKNOWN_OBJECT, f"unknown object {target.label}")
-    if not target.held and actions.distance_to_footprint(body.world, name) > actions.REACH_M:
+    if not target.held and distance > ROBOT.reach_m:
         moved = navigate(body, graph, target)
         if not moved.ok:
             return moved
-    result = body.act(verb, name)  # the env's go-to-and-act: the final approach when still out of reach
-    body.record_jump(result.path, result.low_level_steps)
+    result = body.act(verb, target.label)  # the robot's go-to-and-act: the final approach when still out of reach
+    body.sense_after(result)
     if result.ok:
-        body.sense(acted_on=(name,))  # what opening / placing revealed; the new state even out of view
+        body.sense(acted_on=(target.label,))  # what opening / placing revealed; the new state even out of view
     return ActionResult(
         ok=result.ok,
         reason=result.reason,
@@ -164,8 +164,7 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     """Put the held item on the floor: where the robot stands, or in ``region_id`` after driving to the
     region's navigation node closest to its centre (floors are the rooms themselves, not graph objects)."""
     start = body.low_level_steps
-    world = body.world
-    if world.robot.held is None:
+    if body.robot.held is None:
         return _fail(FailureReason.HAND_EMPTY, "hand is empty")
     if region_id is not None and graph.robot.region_id != region_id:
         region = graph.regions[region_id]
@@ -176,11 +175,11 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
         reached, _, why = _drive(body, graph, [centre])
         if not reached:
             return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {room}: {why}", body.low_level_steps - start)
-    room_id = world.room_at(*body.xy)
-    if room_id is None:
+    floor = body.robot.floor_here()
+    if floor is None:
         return _fail(FailureReason.INVALID_TARGET, "no floor here", body.low_level_steps - start)
-    result = body.act("place_ontop", floor_name(room_id))
-    body.record_jump(result.path, result.low_level_steps)
+    result = body.act("place_ontop", floor)
+    body.sense_after(result)
     if result.ok:
         body.sense()  # the hand is empty now: without a frame the graph would still show the item held
     feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"

@@ -1,6 +1,7 @@
 """What an ideal reader of a task knows before seeing the world: the goal in BDDL form and the description.
 
-:func:`task_goal` turns a task instance into a :class:`TaskGoal`: bddl's ground goal options as
+:func:`task_goal` turns a task instance into a :class:`~more_agent.goal.TaskGoal` (the runner hands it to
+a planner that reads the goal, in its :class:`~more_agent.goal.GoalSpec`): bddl's ground goal options as
 literals over *scope* names (``apple.n.01_1``, never world object names), the object categories each
 scope may be, the instance labels the description names (``apple A``), the room type of each floor
 scope the description names ("the kitchen floor") and which scopes the goal moves. Nothing here
@@ -23,40 +24,17 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
+from more_agent.goal import ROBOT_NAME, Literal, TaskGoal
 from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
-from more_agent.sim.goals import GoalChecker, Literal
+from more_agent.sim.goals import GoalChecker
 from more_agent.sim.instantiate import TaskInstance
-from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.tasks import scope_synset
 from more_agent.vocabulary import FLOOR_SYNSETS
 
 _FLOOR = re.compile(r"^the (.+) floor$")
-
-
-@dataclass(frozen=True)
-class TaskGoal:
-    """The goal of one task as literals over scope names, with what the description says about the scopes."""
-
-    options: tuple[tuple[Literal, ...], ...]
-    """bddl's ground options (each a conjunction that satisfies the goal), literals over scope names."""
-    categories: dict[str, frozenset[str]]
-    """Scope -> object categories that count as it (the synset's own and its descendants'; for a scope the
-    goal moves, no descendant that is a scene fixture: a car is a container, but none to put in a car)."""
-    named: dict[str, str]
-    """Scope -> instance label the description names it by (``apple A``)."""
-    floor_rooms: dict[str, str | None]
-    """Floor scope -> the room type the description names ('kitchen'), None when it names none."""
-    robot: str
-    """The agent's scope name."""
-    moved: frozenset[str] = frozenset()
-    """Scopes the goal moves (subjects of placement literals): only things that can be picked up are them."""
-
-    def is_floor(self, scope: str) -> bool:
-        return scope in self.floor_rooms
 
 
 def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
