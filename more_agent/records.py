@@ -15,10 +15,13 @@ from __future__ import annotations
 from enum import Enum
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-RECORD_SCHEMA_VERSION = 4
-"""4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
+from more_agent.errors import UserError
+from more_agent.perception_spec import parse_perception
+
+RECORD_SCHEMA_VERSION = 5
+"""5: ``perception`` (the perception mode), ``misperceived`` and ``perception_aliases``; 4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
 only); 3: ``history`` (the action history option) and ``descriptions`` (the description mode). Older
 records are read through :data:`UPGRADES`."""
 
@@ -61,6 +64,7 @@ FailureCause = Literal[
     "wrong_instance",
     "done_not_called",
     "done_early",
+    "misperceived",
     "step_limit",
     "invalid_llm_answers",
     "llm_error",
@@ -78,6 +82,18 @@ DEFAULT_HISTORY: HistoryMode = "paper"
 
 LEGACY_HISTORY: HistoryMode = "lasting"
 """What an LLM planner was shown by the versions before the history option (since the skill table)."""
+
+
+GT_PERCEPTION = "gt"
+"""The perception mode of the paper and of every version before the option: ground truth."""
+
+
+def canonical_perception(text: str) -> str:
+    """The canonical text of a perception mode (``more_agent.perception_spec``); ValueError when invalid."""
+    try:
+        return parse_perception(text).text()
+    except UserError as e:
+        raise ValueError(str(e)) from None
 
 
 LEGACY_DESCRIPTIONS = "paper"
@@ -113,7 +129,12 @@ def upgrade_from_3(data: dict[str, Any]) -> dict[str, Any]:
     return data
 
 
-UPGRADES = {2: upgrade_from_2, 3: upgrade_from_3}
+def upgrade_from_4(data: dict[str, Any]) -> dict[str, Any]:
+    """A record of schema 4 in schema 5's form: its episode perceived the ground truth."""
+    return {"perception": GT_PERCEPTION, **data, "schema_version": 5}
+
+
+UPGRADES = {2: upgrade_from_2, 3: upgrade_from_3, 4: upgrade_from_4}
 """Schema version -> the function that turns such a record into the next version's form. Schema 1
 predates the first release: no step exists, and validation refuses it (``record_validation``)."""
 
@@ -216,6 +237,17 @@ class EpisodeRecord(BaseModel):
     history: HistoryMode = Field(
         default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners (others ignore it)."
     )
+    perception: str = Field(
+        default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
+    )
+    misperceived: dict[str, str] = Field(
+        default_factory=dict,
+        description="Task objects in view at some point but never perceived as themselves, and how (noisy perception).",
+    )
+    perception_aliases: dict[str, str] = Field(
+        default_factory=dict,
+        description="Labels noisy perception made up (an instance seen as another category, a fragment) -> world name.",
+    )
     success: bool = Field(default=False, description="All goal conditions met and done() called (SR).")
     all_goals_met: bool = Field(default=False, description="All goal conditions met at the end (TTC).")
     done_called: bool = Field(default=False, description="Whether the planner ended the episode with done().")
@@ -260,7 +292,6 @@ class EpisodeRecord(BaseModel):
         while isinstance(version, int) and version in UPGRADES:
             data, version = UPGRADES[version](data), version + 1
         return data
-        return data
 
     def key(self) -> tuple[str, str, int, str]:
         """Identity of the episode within a run: (task, scene, seed, planner)."""
@@ -279,6 +310,7 @@ class EpisodeRecord(BaseModel):
             distractors=spec.distractors,
             descriptions=spec.descriptions,
             history=spec.history,
+            perception=spec.perception,
             **fields,
         )
 
@@ -306,3 +338,11 @@ class EpisodeSpec(FrozenModel):
         description="'named': the paper's text naming every goal instance the world makes ambiguous; 'paper': verbatim.",
     )
     history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")
+    perception: str = Field(
+        default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
+    )
+
+    @field_validator("perception")
+    @classmethod
+    def _canonical_perception(cls, value: str) -> str:
+        return canonical_perception(value)

@@ -12,8 +12,9 @@ ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
     ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills",
-     "robot_spec", "vocabulary", "robot", "goal"),
+     "robot_spec", "vocabulary", "robot", "goal", "perception_spec"),
     ("sim",),
+    ("perception",),
     ("mapping",),
     ("scene_graph",),
     ("interop",),

@@ -88,6 +88,16 @@ HistoryOption = Annotated[
 ]
 """``--history`` of ``run`` and ``eval``."""
 
+PerceptionOption = Annotated[
+    str,
+    typer.Option(
+        help="Perception: 'gt' (ground truth, the paper's) or 'noisy[:KEY=VALUE,...]' with KEY among confusion, miss, "
+        "fragment, merge, depth, drift, room (0 switches one off; 'noisy' alone: every kind at its default rate; "
+        "docs/sensors.md#noisy-perception)."
+    ),
+]
+"""``--perception`` of ``run`` and ``eval``."""
+
 JsonOption = Annotated[
     bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")
 ]

@@ -15,6 +15,7 @@ from more_agent.commands._common import (
     DescriptionsOption,
     DistractorsOption,
     HistoryOption,
+    PerceptionOption,
     StartOption,
     episodes_exit_status,
     err_console,
@@ -43,6 +44,7 @@ def eval_(
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
     history: HistoryOption = "paper",
+    perception: PerceptionOption = "gt",
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -80,6 +82,7 @@ def eval_(
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
     from more_agent.llm.prompts import check_history
+    from more_agent.perception_spec import parse_perception
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits
@@ -99,6 +102,7 @@ def eval_(
     check_start(start)
     check_description_mode(descriptions)
     history_mode = check_history(history)
+    perception_mode = parse_perception(perception).text()
     if episode_fn in (
         None,
         VIEWER_EPISODE_FN,
@@ -122,6 +126,7 @@ def eval_(
         distractors=distractors,
         descriptions=descriptions,
         history=history_mode,
+        perception=perception_mode,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,

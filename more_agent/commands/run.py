@@ -23,6 +23,7 @@ from more_agent.commands._common import (
     DescriptionsOption,
     DistractorsOption,
     HistoryOption,
+    PerceptionOption,
     StartOption,
     console,
     episodes_exit_status,
@@ -125,6 +126,7 @@ def run(
     distractors: DistractorsOption = True,
     descriptions: DescriptionsOption = "named",
     history: HistoryOption = "paper",
+    perception: PerceptionOption = "gt",
     out: Annotated[
         Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")
     ] = None,
@@ -154,6 +156,7 @@ def run(
     from more_agent.eval.runlock import locked_run_dir
     from more_agent.eval.viewer import run_episode_with_viewer
     from more_agent.llm.prompts import check_history
+    from more_agent.perception_spec import parse_perception
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
@@ -163,6 +166,7 @@ def run(
     check_start(start)
     check_description_mode(descriptions)
     history_mode = check_history(history)
+    perception_mode = parse_perception(perception).text()
     if scene is not None:
         check_scene_suits(task, scene)
     if planner is None:
@@ -182,6 +186,7 @@ def run(
         distractors=distractors,
         descriptions=descriptions,
         history=history_mode,
+        perception=perception_mode,
     )
     recorder = open_bag_recorder(bag, bag_storage) if bag is not None else None
     with (

@@ -38,6 +38,7 @@ from more_agent.safe_files import DISK_FULL_ERRNOS
 
 if TYPE_CHECKING:
     from more_agent.interop.bag_writer import BagRecorder
+    from more_agent.perception.model import NoisyPerception
     from more_agent.robot import Frame
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import GoalChecker, GoalStatus, PrivilegedContext
@@ -106,6 +107,7 @@ def run_episode(
     ``bag`` (an open recorder) gets every frame the robot renders: ``run --bag`` (docs/ros.md).
     """
     from more_agent.llm.errors import LLMError
+    from more_agent.perception.model import perception_for
     from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
@@ -124,6 +126,7 @@ def run_episode(
     world: World | None = None
     goals: GoalChecker | None = None
     robot: SimRobot | None = None
+    perception: NoisyPerception | None = None
     privileged: PrivilegedContext | None = None
     scope: dict[str, str] = {}
     if folder is not None:
@@ -146,6 +149,7 @@ def run_episode(
         record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
+        perception = perception_for(spec.perception, world, spec.seed, spec.task)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
         robot, privileged = reset_planner(
             planner,
@@ -155,6 +159,7 @@ def run_episode(
             history=spec.history,
             on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
             trace_graphs=folder is not None and folder.graphs,
+            perception=perception,
         )
         clock.add("sense", t)
         if folder is not None:
@@ -172,8 +177,12 @@ def run_episode(
         record.traceback = redact(traceback.format_exc())
         record.retryable = isinstance(e, OSError) and e.errno in DISK_FULL_ERRNOS  # free space, run again
     if world is not None and goals is not None and planner is not None:
-        observed = (robot.observed if robot is not None else set()) | (privileged.observed if privileged else set())
+        seen = perception.observed() if perception is not None else robot.observed if robot is not None else set()
+        observed = seen | (privileged.observed if privileged else set())
         _finish(record, goals.check(world), scope, planner, observed)
+        if perception is not None:
+            record.misperceived = perception.misperceived(sorted(set(scope.values())))
+            record.perception_aliases = dict(perception.aliases)
     record.failure = classify_failure(record, world)
     if folder is not None:
         t = time.perf_counter()
@@ -196,11 +205,14 @@ def reset_planner(
     history: HistoryMode = DEFAULT_HISTORY,
     on_frame: Callable[[Frame], None] | None = None,
     trace_graphs: bool = False,
+    perception: NoisyPerception | None = None,
 ) -> tuple[SimRobot, PrivilegedContext | None]:
     """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
-    gets every frame it renders), tell it the task (:func:`goal_spec`), grant the world and the goal
-    checker to a privileged planner (one with ``grant``: the oracle), then ``reset`` it. Returns the
-    robot and the privileged context (None for any other planner)."""
+    gets every frame it renders; with ``perception``, the planner drives it through a
+    :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`), grant the
+    world and the goal checker to a privileged planner (one with ``grant``: the oracle), then ``reset``
+    it. Returns the simulator's robot and the privileged context (None for any other planner)."""
+    from more_agent.perception.robot import NoisyRobot
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import PrivilegedContext
 
@@ -210,7 +222,8 @@ def reset_planner(
     if grant is not None:
         grant(privileged)
     goal = goal_spec(instance, goals, descriptions, with_goal=getattr(planner, "reads_goal", False))
-    planner.reset(EpisodeContext(robot=robot, goal=goal, llm=planner.llm, history=history, trace_graphs=trace_graphs))
+    driven = robot if perception is None else NoisyRobot(robot, perception)
+    planner.reset(EpisodeContext(robot=driven, goal=goal, llm=planner.llm, history=history, trace_graphs=trace_graphs))
     return robot, privileged
 
 

@@ -23,6 +23,7 @@ CAUSE_ORDER: tuple[FailureCause, ...] = (
     "other",
     "done_not_called",
     "wrong_instance",
+    "misperceived",
     "never_observed",
     "invalid_llm_answers",
     "unreachable",
@@ -63,6 +64,9 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
     wrong = _wrong_instances(record.actions, needed, goal_objects, world)
     if wrong:
         return Failure(cause="wrong_instance", detail=wrong)
+    misperceived = _misperceived(record, needed, world)
+    if misperceived:
+        return Failure(cause="misperceived", detail=misperceived)
     unseen = [o for o in needed if o not in set(record.observed_objects)]
     if unseen:
         return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
@@ -105,6 +109,21 @@ def _wrong_instances(
         )
         if others:
             return f"acted on {', '.join(others)}; the goal needs {obj.label or name + ' (never observed)'}"
+    return ""
+
+
+def _misperceived(record: EpisodeRecord, needed: Sequence[str], world: World) -> str:
+    """'apple A: seen as pear C'-style detail when noisy perception hid a needed object that was in view
+    (never perceived as itself), or the robot manipulated an object under a label of another category;
+    '' otherwise (always under ground-truth perception)."""
+    hidden = [f"{world.get(o).label or o}: {record.misperceived[o]}" for o in needed if o in record.misperceived]
+    if hidden:
+        return "; ".join(hidden)
+    for a in record.actions:
+        label = a.arguments[-1] if a.ok and a.name in MANIPULATING and a.arguments else ""
+        real = record.perception_aliases.get(label)
+        if real in world.objects and not label.startswith(world.get(real).category + " "):
+            return f"acted on {label}, which is {world.get(real).label or real}"
     return ""
 
 

@@ -122,6 +122,7 @@ def config_specs(config: RunConfig) -> list[EpisodeSpec]:
             distractors=config.distractors,
             descriptions=config.descriptions,
             history=config.history,
+            perception=config.perception,
         )
         for t in config.tasks
         for s in config.seeds

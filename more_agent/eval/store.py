@@ -23,6 +23,7 @@ from more_agent.eval.runlock import LOCK_FILE
 from more_agent.record_validation import BadRecord, parse_record, record_json
 from more_agent.records import (
     DEFAULT_HISTORY,
+    GT_PERCEPTION,
     LEGACY_DESCRIPTIONS,
     EpisodeRecord,
     EpisodeSpec,
@@ -59,6 +60,9 @@ class RunConfig(BaseModel):
         default="named", description="Description mode of every episode: 'named' or 'paper' (sim.descriptions)."
     )
     history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")
+    perception: str = Field(
+        default=GT_PERCEPTION, description="Perception mode of every episode: 'gt' or 'noisy[:KEY=VALUE,...]'."
+    )
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
@@ -79,6 +83,7 @@ MIXING_FIELDS = (
     "distractors",
     "descriptions",
     "history",
+    "perception",
     "episode_fn",
 )
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
@@ -97,11 +102,13 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     starts = sorted({r.start for r in records})
     histories = sorted({r.history for r in records})
     descriptions = sorted({r.descriptions for r in records})
+    perceptions = sorted({r.perception for r in records})
     return config.model_copy(
         update={
             "start": starts[0] if len(starts) == 1 else ",".join(starts),
             "history": histories[0] if len(histories) == 1 else ",".join(histories),
             "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
+            "perception": perceptions[0] if len(perceptions) == 1 else ";".join(perceptions),
             "planner": planners[0] if len(planners) == 1 else ",".join(planners),
             "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
             "tasks": sorted({r.task for r in records} | set(config.tasks)),
@@ -241,14 +248,15 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
 
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
     """The specs with no record yet, in order: a record counts for a spec when it shares task, seed,
-    planner, LLM, start, description mode, history and distractors (a record that predates the distractors
+    planner, LLM, start, description mode, history, perception and distractors (a record that predates the distractors
     field matches either) and scene (a record of a scene file's scene counts for the file)."""
-    done: dict[tuple[str, int, str, str | None, str, str, str], list[EpisodeRecord]] = {}
+    done: dict[tuple[str, int, str, str | None, str, str, str, str], list[EpisodeRecord]] = {}
     for r in records:
-        done.setdefault((r.task, r.seed, r.planner, r.llm, r.start, r.descriptions, r.history), []).append(r)
+        key = (r.task, r.seed, r.planner, r.llm, r.start, r.descriptions, r.history, r.perception)
+        done.setdefault(key, []).append(r)
     out = []
     for s in specs:
-        key = (s.task, s.seed, s.planner, s.llm, s.start, s.descriptions, s.history)
+        key = (s.task, s.seed, s.planner, s.llm, s.start, s.descriptions, s.history, s.perception)
         scenes = {r.scene for r in done.get(key, []) if r.distractors in (None, s.distractors)}
         if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
             out.append(s)
@@ -279,11 +287,12 @@ def episode_dirname(
     distractors: bool | None = True,
     descriptions: str = "named",
     history: str = "paper",
+    perception: str = "gt",
 ) -> str:
     """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
 
     The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
-    a history other than 'paper' are part of the name, so that the
+    a history other than 'paper' and a perception other than 'gt' are part of the name, so that the
     episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a folder.
     """
     parts = [task, scene or "auto", f"s{seed}", planner]
@@ -297,7 +306,15 @@ def episode_dirname(
         parts.append(f"{descriptions}-descriptions")
     if history != "paper":
         parts.append(f"{history}-history")
+    if perception != "gt":
+        parts.append(perception_part(perception))
     return re.sub(r"[^A-Za-z0-9_.\-]", "_", "__".join(parts))
+
+
+def perception_part(perception: str) -> str:
+    """The perception mode's part of an episode folder name: the canonical text, hashed when long."""
+    text = perception.replace(":", "-").replace("=", "").replace(",", "-")
+    return text if len(text) <= 60 else f"noisy-{hashlib.sha256(perception.encode()).hexdigest()[:12]}"
 
 
 def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str | None = None) -> Path:
@@ -312,6 +329,7 @@ def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str 
         distractors=episode.distractors,
         descriptions=episode.descriptions,
         history=episode.history,
+        perception=episode.perception,
     )
     return Path(run_dir) / EPISODE_DIRS / name
 

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -150,7 +150,8 @@ class GroundedPlanner:
 
     def observe(self) -> None:
         """Build the scene graph; remember what is seen, where it rests and its open state; type rooms."""
-        graph = self.body.step_graph(_room_types)
+        body = self.body
+        graph = body.step_graph(lambda g: _room_types(g, body.room_input))
         self.room_types = {rid: r.room_label for rid, r in graph.regions.items() if r.room_label}
         rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
         for obj in graph.objects.values():
@@ -597,12 +598,13 @@ class GroundedPlanner:
         return needed(self.graph, "observe()")
 
 
-def _room_types(graph: SceneGraph) -> dict[str, str]:
-    """Region id -> the room type its furniture fits best, for the regions without a label."""
+def _room_types(graph: SceneGraph, read: Callable[[Iterable[ObjectNode]], list[str]]) -> dict[str, str]:
+    """Region id -> the room type its furniture fits best, for the regions without a label; ``read`` gives
+    the categories the classifier reads for a region's objects (``Embodiment.room_input``)."""
     labels = {}
     for rid, region in graph.regions.items():
         if region.room_label is None:
-            kind = likely_room_type(o.category for o in graph.objects_in(rid))
+            kind = likely_room_type(read(graph.objects_in(rid)))
             if kind is not None:
                 labels[rid] = kind
     return labels

@@ -220,7 +220,9 @@ class LLMPlanner:
         a region whose answer stays invalid is left unlabelled and asked again next step."""
         labels: dict[str, str] = {}
         for rid, region in sorted(graph.regions.items()):
-            names = sorted({o.category for o in graph.objects_in(rid) if o.category != "door"})
+            objects = [o for o in graph.objects_in(rid) if o.category != "door"]
+            read = self.body.room_input(objects) if self.body is not None else [o.category for o in objects]
+            names = sorted(set(read))  # the robot's reading (room-label noise); a graph from outside as it is
             if region.room_label is not None or not names:
                 continue
             try:

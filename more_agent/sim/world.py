@@ -141,6 +141,13 @@ class World:
             self._labels_used[obj.category] = used + 1
         return obj.label
 
+    def fresh_label(self, category: str) -> str:
+        """The next free label of ``category``, handed out to no object: what a noisy perception calls an
+        instance it sees as another category, or a second piece of one (``more_agent.perception``)."""
+        used = self._labels_used.get(category, 0)
+        self._labels_used[category] = used + 1
+        return f"{category} {_alpha(used)}"
+
     def observe(self, names: Iterable[str]) -> None:
         """Label the objects among ``names`` seen for the first time, in the order given."""
         for name in names:

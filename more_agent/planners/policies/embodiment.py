@@ -13,7 +13,8 @@ or turned far enough since the last frame), so the map grows while the robot dri
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -22,7 +23,7 @@ from more_agent.mapping import MappingConfig
 from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.robot import XY, ActionResult, Frame, Robot
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT, full_turn_angles
-from more_agent.scene_graph import SceneGraph, SceneGraphBuilder
+from more_agent.scene_graph import ObjectNode, SceneGraph, SceneGraphBuilder
 
 PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
@@ -66,6 +67,14 @@ class PolicyConfig(BaseModel):
         "(0.95 m at the Fetch's 63.3 deg).",
     )
     look_around_at_frontier: bool = Field(default=True, description="Turn in place once at a reached frontier.")
+
+
+@runtime_checkable
+class MisreadsRooms(Protocol):
+    """A robot whose room classifier input errs (``more_agent.perception.robot.NoisyRobot``, room-label noise)."""
+
+    def room_input(self, objects: Iterable[tuple[str, str]]) -> list[str]:
+        """The categories the room classifier reads for (label, category) pairs."""
 
 
 class Embodiment:
@@ -153,6 +162,14 @@ class Embodiment:
         """Sense on the way: only when the schedule says the robot moved or turned far enough."""
         if self.schedule.due(*self.robot.pose):
             self.sense()
+
+    def room_input(self, objects: Iterable[ObjectNode]) -> list[str]:
+        """The categories the room classifier reads for these objects: theirs, or with a robot of noisy
+        perception, some read as another category (room-label noise, docs/sensors.md#noisy-perception)."""
+        pairs = [(o.label, o.category) for o in objects]
+        if isinstance(self.robot, MisreadsRooms):
+            return self.robot.room_input(pairs)
+        return [category for _, category in pairs]
 
     def build(self) -> SceneGraph:
         """The scene graph of everything sensed so far, from the robot's position (joined with the
