@@ -166,6 +166,10 @@ class LLMUsage(BaseModel):
         default=0,
         description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server).",
     )
+    reasoning_tokens: int = Field(
+        default=0,
+        description="Of completion_tokens, those spent on free reasoning before the command (by the share of characters).",
+    )
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 

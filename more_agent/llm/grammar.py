@@ -1,11 +1,12 @@
 """Length bounds for grammar-constrained JSON answers of local models (llama.cpp).
 
 llama.cpp compiles an answer's JSON schema into a grammar, which fixes the shape of the answer but
-not its length: a small model at temperature 0 can repeat one sentence inside a string, or one name
-inside a list, until ``max_tokens`` cuts the JSON off. The grammar therefore gets the bounds that
-the answer schemas leave open: names at most :data:`NAME_CHARS` characters, free text
-(:data:`FREE_TEXT_FIELDS`) at most :data:`TEXT_CHARS`, lists at most :data:`MAX_ITEMS` items. A bounded
-answer still follows the original schema. Only grammars built here (in process, or through
+not its length: a small model at temperature 0 can repeat one name inside a list until ``max_tokens``
+cuts the JSON off. The grammar therefore gets the bounds that the answer schemas leave open: names at
+most :data:`NAME_CHARS` characters, lists at most :data:`MAX_ITEMS` items. Free text
+(:data:`FREE_TEXT_FIELDS`: the reasoning and analysis a model writes before its command) has no
+length cap: none of the papers limits it, and ``max_tokens`` bounds it. A bounded answer still
+follows the original schema. Only grammars built here (in process, or through
 llama.cpp's server) get the bounds; the schema sent to hosted APIs and keyed in the cache is unchanged.
 """
 
@@ -16,11 +17,8 @@ from typing import Any
 NAME_CHARS = 64
 """Longest string for names (rooms, objects, skills, room types): the longest scene name is about 40."""
 
-TEXT_CHARS = 320
-"""Longest free-text string: the plan's reasoning asks for one or two short sentences."""
-
-FREE_TEXT_FIELDS = frozenset({"reasoning"})
-"""Answer fields holding free text rather than a name."""
+FREE_TEXT_FIELDS = frozenset({"reasoning", "analysis"})
+"""Answer fields holding free text rather than a name: never bounded here (``max_tokens`` bounds them)."""
 
 MAX_ITEMS = 16
 """Longest list: arguments of a skill, rooms kept by the filter, relevant objects in one room."""
@@ -29,7 +27,7 @@ MAX_ITEMS = 16
 def bounded_schema(schema: Any, field: str = "") -> Any:
     """A copy of ``schema`` with ``maxLength`` on unbounded strings and ``maxItems`` on unbounded arrays.
 
-    ``field`` is the property name the (sub)schema belongs to; it picks free-text or name bounds.
+    ``field`` is the property name the (sub)schema belongs to; free-text fields stay unbounded.
     """
     if isinstance(schema, list):
         return [bounded_schema(item, field) for item in schema]
@@ -43,8 +41,8 @@ def bounded_schema(schema: Any, field: str = "") -> Any:
             out[key] = {name: bounded_schema(sub) for name, sub in value.items()}
         else:
             out[key] = bounded_schema(value, field)
-    if out.get("type") == "string" and "maxLength" not in out and "enum" not in out:
-        out["maxLength"] = TEXT_CHARS if field in FREE_TEXT_FIELDS else NAME_CHARS
+    if out.get("type") == "string" and "maxLength" not in out and "enum" not in out and field not in FREE_TEXT_FIELDS:
+        out["maxLength"] = NAME_CHARS
     if out.get("type") == "array" and "maxItems" not in out:
         out["maxItems"] = MAX_ITEMS
     return out

@@ -12,6 +12,7 @@ from more_agent.llm.client import Backend, ChatClient
 from more_agent.llm.config import CacheMode, LLMConfig
 from more_agent.llm.errors import BadLLMSpec
 from more_agent.llm.local_models import BUNDLED_MODELS, gguf_path, is_bundled
+from more_agent.llm.name_enums import uses_name_enums
 from more_agent.redaction import has_credentials
 
 BACKEND_KINDS = ("openai", "llamacpp")
@@ -91,12 +92,14 @@ def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:
     if config.cache_mode is not CacheMode.OFF:
         check_cache_path(config.cache_path, write=config.cache_mode is not CacheMode.REPLAY)
         cache = ResponseCache(config.cache_path, busy_timeout_s=config.cache_busy_timeout_s)
+    backend = make_backend(spec, config)
     return ChatClient(
-        make_backend(spec, config),
+        backend,
         cache=cache,
         cache_mode=config.cache_mode,
         temperature=config.temperature,
         max_tokens=config.max_tokens,
         seed=config.seed,
         prices=config.prices,
+        name_enums=uses_name_enums(config, backend.kind),
     )

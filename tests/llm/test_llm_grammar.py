@@ -5,13 +5,13 @@ from __future__ import annotations
 import json
 
 from more_agent.llm import FilterAnswer, PlanAnswer, RoomLabelAnswer
-from more_agent.llm.grammar import MAX_ITEMS, NAME_CHARS, TEXT_CHARS, bounded_schema
+from more_agent.llm.grammar import MAX_ITEMS, NAME_CHARS, bounded_schema
 from more_agent.llm.jsontext import json_schema_of
 
 
-def test_free_text_names_and_lists_get_their_bounds() -> None:
+def test_names_and_lists_get_their_bounds_and_reasoning_stays_free() -> None:
     plan = bounded_schema(json_schema_of(PlanAnswer))["properties"]
-    assert plan["reasoning"]["maxLength"] == TEXT_CHARS and plan["skill"]["maxLength"] == NAME_CHARS
+    assert "maxLength" not in plan["reasoning"] and plan["skill"]["maxLength"] == NAME_CHARS
     assert plan["arguments"]["maxItems"] == MAX_ITEMS and plan["arguments"]["items"]["maxLength"] == NAME_CHARS
 
 

@@ -154,5 +154,7 @@ def test_moma_llm_names_objects_by_class_and_does_not_filter(tmp_path: Path) -> 
         record = _run(server, tmp_path, spec=SPEC.model_copy(update={"planner": "moma-llm"}))
     assert record.error is None and record.actions[0].ok and record.actions[0].feedback == "opened fridge A"
     assert not any("Remove every object" in r.body["messages"][0]["content"] for r in server.requests)
-    scene = server.requests[-1].body["messages"][-1]["content"].split("Scene:\n", 1)[1].split("\n\n", 1)[0]
-    assert "fridge [open]" in scene and "fridge A" not in scene and "bottom_cabinet (x2) [closed]" in scene
+    prompt = server.requests[-1].body["messages"]
+    scene = prompt[-1]["content"].split("Rooms and the objects found in them so far:\n", 1)[1].split("\nRooms with", 1)[0]
+    assert "opened fridge" in scene and "fridge A" not in scene and "closed bottom_cabinet, closed bottom_cabinet" in scene
+    assert "Analysis" not in prompt[0]["content"] and '"analysis"' in prompt[0]["content"]
