@@ -5,12 +5,17 @@ from __future__ import annotations
 import pytest
 
 from more_agent.llm import InvalidAnswer
+from more_agent.planners.base import EpisodeContext
 from more_agent.planners.language import scene_view
-from more_agent.planners.llm_planner import PLANNER_CONFIGS
+from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.planners.moma_encoding import distance_word, moma_history, moma_scene, without_state
 from more_agent.planners.plan_prompts import PlanRequest, PlanState, plan_request
 from more_agent.records import ActionRecord
+from more_agent.sim.goals import GoalChecker
+from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.scene import load_scene
 from tests.planners.test_language import _check_snapshot, _obj, hand_made_graph
+from tests.planners.test_scene_text_consistency import TINY, RandomBrain, ScriptedClient
 
 HISTORY = [
     ActionRecord(step=0, name="explore", arguments=["kitchen_0"], ok=False, feedback="no unexplored area left"),
@@ -98,3 +103,16 @@ def test_the_held_object_is_neither_in_a_room_nor_nearby() -> None:
     graph = hand_made_graph()
     scene = moma_scene(graph, scene_view(graph, PLANNER_CONFIGS["moma-llm"].language))
     assert all("book" not in objs for _, objs in scene.rooms) and "book" not in scene.nearby
+
+
+@pytest.mark.parametrize(("planner", "task"), [
+    ("moma-llm", "put every pomegranate inside the fridge; put every mango inside the fridge"),
+    ("more", "put every pomegranate inside fridge A; put every mango inside fridge A"),
+])
+def test_moma_llm_gets_the_description_by_class(planner: str, task: str) -> None:
+    """MoMa-LLM's text never shows 'fridge A', so its task says 'the fridge'; MORE's keeps the label."""
+    instance = instantiate_in_scene("store_produce", load_scene(TINY), seed=0)
+    client = ScriptedClient(RandomBrain(0))
+    agent = LLMPlanner(PLANNER_CONFIGS[planner], LLMClients(client, client, "scripted"))
+    agent.reset(EpisodeContext(instance=instance, goals=GoalChecker(instance), history="paper"))
+    assert agent.task == task
