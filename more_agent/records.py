@@ -208,6 +208,9 @@ class EpisodeRecord(BaseModel):
         description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'."
     )
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
+    room_llm: str | None = Field(
+        default=None, description="LLM that labelled rooms (MORE, MoMa-LLM; the paper: gpt-3.5-turbo); None: no rooms."
+    )
     start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
     distractors: bool | None = Field(
         default=None,

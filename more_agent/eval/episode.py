@@ -134,6 +134,7 @@ def run_episode(
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
+        record.room_llm = getattr(planner, "room_llm", None)  # only the planners that label rooms have one
         world = instance.world
         record.scene, record.description = instance.scene, instance.description
         record.world_stats = world_stats(instance)

@@ -84,7 +84,8 @@ class LLMConfig(BaseModel):
     )
     room_model: str | None = Field(
         default=None,
-        description="Cheaper model for room classification, same endpoint (paper: gpt-3.5-turbo); None = same model.",
+        description="LLM for room classification (paper: gpt-3.5-turbo): a spec such as 'openai:gpt-3.5-turbo', or a "
+        "model name on the planning model's endpoint; None = the planning model (--room-llm).",
     )
     base_url: str | None = Field(
         default=None,

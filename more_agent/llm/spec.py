@@ -66,9 +66,14 @@ def llm_configured(config: LLMConfig, cli_spec: str | None = None) -> bool:
 
 
 def room_spec(spec: LLMSpec, config: LLMConfig) -> LLMSpec:
-    """The LLM for room classification: ``config.room_model`` on the same endpoint (openai), else ``spec``."""
-    if spec.kind == "openai" and config.room_model:
-        return LLMSpec(kind="openai", model=config.room_model)
+    """The LLM for room classification (the paper: GPT-3.5 Turbo, GPT-4o for the rest): ``config.room_model``
+    as a full spec (``openai:gpt-3.5-turbo``, ``llamacpp:smollm2``), or a bare model name on the planning
+    model's OpenAI-compatible endpoint; the planning model ``spec`` when it is unset."""
+    room = config.room_model
+    if room and room.partition(":")[0].strip().lower() in BACKEND_KINDS:
+        return parse_llm_spec(room)
+    if spec.kind == "openai" and room:
+        return LLMSpec(kind="openai", model=room)
     return spec
 
 

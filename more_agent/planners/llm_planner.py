@@ -113,6 +113,8 @@ class LLMClients:
     room: LLMClient
     spec: str
     """The planning LLM as a spec, e.g. 'openai:gpt-4o' (for the episode record)."""
+    room_spec: str = ""
+    """The room-classification LLM as a spec ('' = the planning LLM), for the episode record."""
 
 
 def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients:
@@ -125,7 +127,8 @@ def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients
         )
     rooms = room_spec(spec, config)
     plan = make_client(spec, config)
-    return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config), spec=str(spec))
+    room = plan if rooms == spec else make_client(rooms, config)
+    return LLMClients(plan=plan, room=room, spec=str(spec), room_spec=str(rooms))
 
 
 class LLMPlanner:
@@ -134,6 +137,8 @@ class LLMPlanner:
     def __init__(self, config: LLMPlannerConfig, clients: LLMClients) -> None:
         self.name = config.name
         self.llm: str | None = clients.spec
+        self.room_llm: str | None = clients.room_spec or clients.spec
+        """The LLM that labels rooms (the episode record's ``room_llm``)."""
         self.config = config
         self.calls = CallLog()
         """Every LLM call (room labels, filter, plan, re-asks): the episode's usage, the step's exchanges."""
@@ -141,6 +146,7 @@ class LLMPlanner:
             plan=RecordingClient(clients.plan, self.calls),
             room=RecordingClient(clients.room, self.calls),
             spec=clients.spec,
+            room_spec=clients.room_spec,
         )
         self.body: Embodiment | None = None
         self.task = ""
