@@ -19,10 +19,11 @@ it replay without it.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from typing import Any, Literal, get_origin
+from typing import Any, Literal, TypeVar, cast, get_origin
 
 from pydantic import BaseModel, create_model
 
+from more_agent.llm.answers import FilterAnswer, RoomObjects
 from more_agent.llm.config import LLMConfig, NameEnums
 
 
@@ -39,7 +40,10 @@ def constrains_names(client: object) -> bool:
     return bool(getattr(client, "name_enums", False))
 
 
-def with_name_enums(model: type[BaseModel], names: Mapping[str, Iterable[str]]) -> type[BaseModel]:
+M = TypeVar("M", bound=BaseModel)
+
+
+def with_name_enums(model: type[M], names: Mapping[str, Iterable[str]]) -> type[M]:
     """A subclass of ``model`` whose fields in ``names`` (``str`` or ``list[str]``) accept only those names.
 
     Names are deduplicated and sorted, so equal name sets give equal schemas (and cache keys). A field
@@ -55,4 +59,16 @@ def with_name_enums(model: type[BaseModel], names: Mapping[str, Iterable[str]]) 
         fields[field] = (list[choice] if get_origin(info.annotation) is list else choice, info)
     if not fields:
         return model
-    return create_model(model.__name__, __base__=model, __doc__=model.__doc__, **fields)
+    return cast(type[M], create_model(model.__name__, __base__=model, __doc__=model.__doc__, **fields))
+
+
+def filter_answer_with_names(rooms: Iterable[str], objects: Iterable[str]) -> type[FilterAnswer]:
+    """MORE's filter answer whose room and object names are enumerated (the nested room entries too)."""
+    entry: Any = with_name_enums(RoomObjects, {"room": rooms, "objects": objects})
+    if entry is RoomObjects:
+        return FilterAnswer
+    entries: Any = list[entry]
+    info = FilterAnswer.model_fields["rooms"]
+    return create_model(
+        FilterAnswer.__name__, __base__=FilterAnswer, __doc__=FilterAnswer.__doc__, rooms=(entries, info)
+    )

@@ -49,6 +49,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from more_agent.llm import InvalidAnswer, LLMClient, ask_validated
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
+from more_agent.llm.name_enums import constrains_names, with_name_enums
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.bumble_memory import (
@@ -93,7 +94,7 @@ from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import ActionResult, FailureReason
 from more_agent.sim.navgrid import XY
 from more_agent.sim.render import Frame
-from more_agent.skills import INVALID
+from more_agent.skills import INVALID, SKILLS
 
 log = logging.getLogger(__name__)
 
@@ -227,7 +228,10 @@ class BumblePlanner:
         """Step decision, then the skill's parameter steps; ``invalid`` when an answer stays unusable."""
         self.decision = Decision()
         try:
-            skill, subtask = self._ask(self._step_messages(), StepAnswer, parse_step, "plan")
+            schema = StepAnswer
+            if constrains_names(self.client):
+                schema = with_name_enums(StepAnswer, {"skill": [s.name for s in SKILLS]})
+            skill, subtask = self._ask(self._step_messages(), schema, parse_step, "plan")
             if skill == DONE:
                 return HighLevelAction(name=DONE, note=subtask)
             self.decision = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)

@@ -50,7 +50,7 @@ from more_agent.llm import (
     room_spec,
 )
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
-from more_agent.llm.name_enums import constrains_names
+from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, with_name_enums
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
 from more_agent.planners.exchanges import CallLog, RecordingClient
@@ -238,6 +238,9 @@ class LLMPlanner:
         """Room labels for regions without one that have objects (one call each with the room model);
         a region whose answer stays invalid is left unlabelled and asked again next step."""
         labels: dict[str, str] = {}
+        schema = RoomLabelAnswer
+        if constrains_names(self.clients.room):
+            schema = with_name_enums(RoomLabelAnswer, {"room": self.config.room_types})
         for rid, region in sorted(graph.regions.items()):
             names = sorted({o.category for o in graph.objects_in(rid) if o.category != "door"})
             if region.room_label is not None or not names:
@@ -246,7 +249,7 @@ class LLMPlanner:
                 answer = ask_validated(
                     self.clients.room,
                     room_messages(names, self.config.room_types),
-                    RoomLabelAnswer,
+                    schema,
                     lambda a: parse_room_label(a, self.config.room_types),
                     max_reasks=self.config.max_reasks,
                     purpose="room",
@@ -326,7 +329,7 @@ def filter_view(
         answer = ask_validated(
             client,
             filter_messages(task, view.text()),
-            FilterAnswer,
+            filter_answer_with_names(view.names(), view.object_names()) if constrains_names(client) else FilterAnswer,
             lambda a: parse_filter_answer(a, view.names()),
             max_reasks=max_reasks,
             purpose="filter",

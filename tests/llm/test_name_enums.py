@@ -7,11 +7,11 @@ import json
 import pytest
 
 from more_agent.llm import ChatMessage, LLMConfig, PlanAnswer, ask_validated, make_client
-from more_agent.llm.answers import MomaPlanAnswer
+from more_agent.llm.answers import FilterAnswer, MomaPlanAnswer, RoomLabelAnswer
 from more_agent.llm.config import NameEnums, StructuredOutput
 from more_agent.llm.grammar import bounded_schema
 from more_agent.llm.jsontext import json_schema_of
-from more_agent.llm.name_enums import constrains_names, uses_name_enums, with_name_enums
+from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, uses_name_enums, with_name_enums
 from more_agent.llm.parsing import parse_plan_answer
 from more_agent.llm.usage import reasoning_tokens
 from more_agent.skills import SKILLS
@@ -96,3 +96,14 @@ def test_reasoning_tokens_are_the_reasoning_share_of_the_answer(
     fake_openai.push(Reply(text, completion_tokens=120))
     out = make_client("openai:gpt-4o", llm_config).complete(MESSAGES, schema=MomaPlanAnswer, purpose="plan")
     assert reasoning_tokens(out) == round(120 * 400 / len(text)) and 100 < reasoning_tokens(out) < 120
+
+
+def test_filter_answers_enumerate_rooms_and_objects_in_their_nested_entries() -> None:
+    """The filter answer is where SmolLM2 wrote '<object name_optional_1>': its nested names are enumerated."""
+    schema = json_schema_of(filter_answer_with_names({"kitchen_0": [], "living_room_0": []}, OBJECTS))
+    entry = schema["$defs"]["RoomObjects"]["properties"]
+    assert entry["room"]["enum"] == ROOMS and entry["objects"]["items"]["enum"] == sorted(OBJECTS)
+    assert schema["properties"]["rooms"]["items"] == {"$ref": "#/$defs/RoomObjects"}
+    assert filter_answer_with_names({}, []) is FilterAnswer
+    room = json_schema_of(with_name_enums(RoomLabelAnswer, {"room": ["kitchen", "bathroom"]}))
+    assert room["properties"]["room"]["enum"] == ["bathroom", "kitchen"]
