@@ -17,6 +17,7 @@ affected by other load on the machine; ``load_avg`` is the 1-minute load at the 
 generation and for prompts (its default: half the cores and all of them).
 
     python benchmarks/local_llm.py [--llm llamacpp:smollm2] [--tasks putting_shopping_away ...] [--steps 3] [--threads N]
+        [--planner more|moma-llm|moma-llm-sr] [--name-enums auto|on|off]
 """
 
 from __future__ import annotations
@@ -67,6 +68,8 @@ class MeasuredClient:
         if not isinstance(client.backend, LlamaCppBackend):
             raise SystemExit(f"--llm must name a llamacpp model, not {client.backend.kind}")
         self.client, self.backend = client, client.backend
+        self.name_enums = client.name_enums
+        """Forwarded: the planners enumerate valid names in their schemas when the client asks for it."""
         self.calls: list[Call] = []
 
     @property
@@ -128,11 +131,11 @@ def summary(calls: Sequence[Call]) -> dict[str, object]:
     }
 
 
-def run_task(task: str, client: MeasuredClient, steps: int, seed: int) -> dict[str, object]:
-    """Up to ``steps`` high-level steps of ``more`` on the task's first suitable scene."""
+def run_task(task: str, client: MeasuredClient, steps: int, seed: int, planner_name: str = "more") -> dict[str, object]:
+    """Up to ``steps`` high-level steps of ``planner_name`` on the task's first suitable scene."""
     scene = suitable_scenes(task)[0]
     instance = instantiate(task, scene, seed)
-    planner = LLMPlanner(PLANNER_CONFIGS["more"], LLMClients(client, client, f"llamacpp:{client.model}"))
+    planner = LLMPlanner(PLANNER_CONFIGS[planner_name], LLMClients(client, client, f"llamacpp:{client.model}"))
     first_call = len(client.calls)
     reset_planner(planner, instance, GoalChecker(instance))
     step_s, cpu_s, llm_s = [], [], []
@@ -165,20 +168,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--steps", type=int, default=3)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--threads", type=int, default=None, help="llama.cpp threads (default: llama.cpp's choice)")
+    parser.add_argument("--planner", default="more", choices=sorted(PLANNER_CONFIGS))
+    parser.add_argument("--name-enums", default="auto", choices=["auto", "on", "off"],
+                        help="enumerate valid names in the answer schemas (auto: on for llama.cpp)")
     args = parser.parse_args(argv)
     load_start = round(os.getloadavg()[0], 1)
-    config = load_llm_config(overrides={"cache_mode": CacheMode.OFF, "llamacpp_n_threads": args.threads})
+    config = load_llm_config(overrides={"cache_mode": CacheMode.OFF, "llamacpp_n_threads": args.threads,
+                                        "name_enums": args.name_enums})
     client = MeasuredClient(make_client(args.llm, config))
     t0 = time.perf_counter()
     client.backend.llama()
     load_s = time.perf_counter() - t0
     rows = []
     for task in args.tasks:
-        rows.append(run_task(task, client, args.steps, args.seed))
+        rows.append(run_task(task, client, args.steps, args.seed, args.planner))
         print(json.dumps(rows[-1]), flush=True)
     steps = [r["s_per_step"]["median"] for r in rows]  # type: ignore[index]
     print(json.dumps({
-        "summary": True, "llm": args.llm, "model": client.model, "n_ctx": client.backend.n_ctx,
+        "summary": True, "llm": args.llm, "model": client.model, "planner": args.planner,
+        "name_enums": client.name_enums, "n_ctx": client.backend.n_ctx,
         "threads": [client.backend.llama().n_threads, client.backend.llama().n_threads_batch], "cpus": os.cpu_count(),
         "load_avg": [load_start, round(os.getloadavg()[0], 1)], "load_s": round(load_s, 2),
         "s_per_step_median_of_tasks": round(statistics.median(steps), 2), **summary(client.calls),

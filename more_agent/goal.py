@@ -65,6 +65,9 @@ class GoalSpec:
 
     text: str
     """The task description in words, as the LLM planners read it."""
+    class_text: str = ""
+    """The description naming instances by class ('the fridge') rather than label ('fridge A'), for a
+    planner whose scene text shows classes (MoMa-LLM's encoding); '' when there is none."""
     descriptions: str = "named"
     """How ``text`` was written: 'named' (the paper's text naming the instances the world makes
     ambiguous) or 'paper' (verbatim)."""

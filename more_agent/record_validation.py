@@ -116,6 +116,7 @@ _COUNTS = frozenset(
         "images",
         "image_bytes",
         "image_tokens",
+        "reasoning_tokens",
         "objects",
         "task_objects",
         "distractors",

@@ -187,6 +187,10 @@ class LLMUsage(BaseModel):
         default=0,
         description="Prompt tokens OpenAI bills for those images (included in prompt_tokens by OpenAI's server).",
     )
+    reasoning_tokens: int = Field(
+        default=0,
+        description="Of completion_tokens, those spent on free reasoning before the command (by the share of characters).",
+    )
     seconds: float = Field(default=0.0, description="Wall time spent waiting for answers (cache lookups included).")
 
 
@@ -225,6 +229,9 @@ class EpisodeRecord(BaseModel):
         description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'."
     )
     llm: str | None = Field(default=None, description="LLM spec, e.g. 'openai:gpt-4o'; None for the oracle.")
+    room_llm: str | None = Field(
+        default=None, description="LLM that labelled rooms (MORE, MoMa-LLM; the paper: gpt-3.5-turbo); None: no rooms."
+    )
     start: str = Field(default="random", description="Start mode of the robot ('random', 'random-area', 'task-room').")
     distractors: bool | None = Field(
         default=None,

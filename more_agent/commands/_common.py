@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import json
 import logging
+import os
 import sys
 import warnings
 from collections.abc import Callable, Iterable
@@ -97,6 +98,46 @@ PerceptionOption = Annotated[
     ),
 ]
 """``--perception`` of ``run`` and ``eval``."""
+
+
+RoomLLMOption = Annotated[
+    str | None,
+    typer.Option(
+        help="LLM for room classification, e.g. openai:gpt-3.5-turbo as in the paper (default: the planning LLM; "
+        "also MORE_AGENT_ROOM_MODEL). Recorded as room_llm in every episode record."
+    ),
+]
+"""``--room-llm`` of ``run`` and ``eval``."""
+
+
+def use_room_llm(spec: str | None) -> None:
+    """Make ``spec`` the room-classification LLM of this process and the workers it starts (through
+    ``MORE_AGENT_ROOM_MODEL``, which the planners' LLM config reads); a bad spec fails here."""
+    if spec is None:
+        return
+    from more_agent.llm import parse_llm_spec
+    from more_agent.llm.constants import ENV_ROOM_MODEL
+
+    os.environ[ENV_ROOM_MODEL] = str(parse_llm_spec(spec))
+
+
+BumbleMemoryOption = Annotated[
+    Path | None,
+    typer.Option(
+        help="BUMBLE's long-term memory (its --add_past): a JSON Lines file of failure summaries, read at the start "
+        "of each BUMBLE episode of a task and appended to on each failed step (also MORE_AGENT_BUMBLE_MEMORY)."
+    ),
+]
+"""``--bumble-memory`` of ``run`` and ``eval``."""
+
+
+def use_bumble_memory(path: Path | None) -> None:
+    """Make ``path`` the BUMBLE long-term memory file of this process and its workers (``MORE_AGENT_BUMBLE_MEMORY``)."""
+    if path is not None:
+        from more_agent.planners.bumble_memory import ENV_MEMORY
+
+        os.environ[ENV_MEMORY] = str(path.resolve())
+
 
 JsonOption = Annotated[
     bool, typer.Option("--json", help="Print JSON (keys documented in docs/cli-json.md) instead of a table.")

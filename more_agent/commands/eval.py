@@ -12,13 +12,17 @@ from more_agent.commands._common import (
     EXIT_FAILED,
     EXIT_RETRYABLE,
     MAX_SEEDS,
+    BumbleMemoryOption,
     DescriptionsOption,
     DistractorsOption,
     HistoryOption,
     PerceptionOption,
+    RoomLLMOption,
     StartOption,
     episodes_exit_status,
     err_console,
+    use_bumble_memory,
+    use_room_llm,
     user_errors_exit_2,
 )
 from more_agent.errors import UserError
@@ -35,6 +39,8 @@ def eval_(
     ],
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
+    room_llm: RoomLLMOption = None,
+    bumble_memory: BumbleMemoryOption = None,
     seeds: Annotated[int, typer.Option(min=1, max=MAX_SEEDS, help="Seeds per task: 0 .. N-1.")] = 1,
     scene: Annotated[
         str | None,
@@ -98,6 +104,8 @@ def eval_(
         )
     if llm is not None:
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
+    use_room_llm(room_llm)
+    use_bumble_memory(bumble_memory)
     names = resolve_tasks(tasks)
     check_start(start)
     check_description_mode(descriptions)

@@ -20,13 +20,17 @@ from rich.text import Text
 
 from more_agent.commands._common import (
     MAX_SEED,
+    BumbleMemoryOption,
     DescriptionsOption,
     DistractorsOption,
     HistoryOption,
     PerceptionOption,
+    RoomLLMOption,
     StartOption,
     console,
     episodes_exit_status,
+    use_bumble_memory,
+    use_room_llm,
     user_errors_exit_2,
 )
 from more_agent.errors import UserError, check_writable_dir
@@ -135,6 +139,8 @@ def run(
     ] = False,
     save_graph: Annotated[bool, typer.Option("--save-graph", help="Also write the scene graph of every step.")] = False,
     llm: Annotated[str | None, typer.Option(help="LLM spec such as openai:gpt-4o (LLM planners only).")] = None,
+    room_llm: RoomLLMOption = None,
+    bumble_memory: BumbleMemoryOption = None,
     viewer: Annotated[
         bool, typer.Option("--viewer", help="Also write viewer.html, a page that steps through the episode.")
     ] = False,
@@ -163,6 +169,8 @@ def run(
     from more_agent.sim.tasks import check_scene_suits, load_task
 
     load_task(task)  # an unknown task fails first, with the closest names
+    use_room_llm(room_llm)
+    use_bumble_memory(bumble_memory)
     check_start(start)
     check_description_mode(descriptions)
     history_mode = check_history(history)

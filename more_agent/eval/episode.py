@@ -144,6 +144,7 @@ def run_episode(
         goals, scope = GoalChecker(instance), instance.scope
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
+        record.room_llm = getattr(planner, "room_llm", None)  # only the planners that label rooms have one
         world = instance.world
         record.scene, record.description = instance.scene, instance.description
         record.world_stats = world_stats(instance)
@@ -228,11 +229,14 @@ def reset_planner(
 
 
 def goal_spec(instance: TaskInstance, goals: GoalChecker, descriptions: str, *, with_goal: bool) -> GoalSpec:
-    """What a planner is told of its task: the description, and the goal's literals when it reads them."""
+    """What a planner is told of its task: the description (also by class), and the goal's literals when it
+    reads them."""
     from more_agent.sim.task_goal import task_goal
 
     goal = task_goal(instance, goals) if with_goal else None
-    return GoalSpec(text=instance.description, descriptions=descriptions, goal=goal)
+    return GoalSpec(
+        text=instance.description, class_text=instance.class_description, descriptions=descriptions, goal=goal
+    )
 
 
 def world_stats(instance: TaskInstance) -> WorldStats:

@@ -109,6 +109,17 @@ def failure_markdown(records: Sequence[EpisodeRecord]) -> str:
     return _md_table(header, rows)
 
 
+TABLE_I_CAVEATS = (
+    "Where this setting differs from the paper's (docs/evaluation.md): the VLM of the BUMBLE rows sees our "
+    "renderer's flat-shaded boxes, each category in a colour from a hash of its name, not OmniGibson's "
+    "photorealistic frames; BUMBLE's frame captions and object lists carry the scene graph's ground-truth "
+    "names, states and relations, which matches the paper's ground-truth semantics but not what BUMBLE's VLM "
+    "saw (it had to recognise objects in the image); manipulation is the paper's magic actions, within "
+    "1.5 m of a reachable pose. None of these effects has been measured yet."
+)
+"""What a reader of Table I must know beside it (summary.md and report.html)."""
+
+
 def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluation summary") -> str:
     """The whole summary.md: Table I, notes on the metrics, the per-task table."""
     return (
@@ -120,6 +131,7 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
                 "rTP. Episodes are weighted equally; errored episodes count as failures. rTP counts the goal "
                 "conditions that name an observed task object; an episode that observed none has no rTP and "
                 "leaves its mean (its n is then given).",
+                TABLE_I_CAVEATS,
                 "## Failure causes",
                 failure_markdown(records),
                 "## Per task",

@@ -18,7 +18,7 @@ from urllib.parse import quote
 
 from more_agent.eval.episode_folder import MAP_FILE, VIEWER_FILE
 from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_task, rtp, system_label
-from more_agent.eval.report import NO_VALUE, SourcedRecord, metric_cells
+from more_agent.eval.report import NO_VALUE, TABLE_I_CAVEATS, SourcedRecord, metric_cells
 from more_agent.eval.store import EPISODE_DIRS, episode_dir, episode_dirname
 from more_agent.records import EpisodeRecord
 
@@ -170,6 +170,6 @@ def render_report(
         f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{escape(title)}</title>'
         f"<style>{_STYLE}</style></head><body><h1>{escape(title)}</h1>"
         f"<p>{len(records)} episodes, {calls} LLM calls, ${cost:.2f}. Means in percent with 95% intervals "
-        f'(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}<div class="plots">{plots_html(plots, base)}</div>'
+        f'(Wilson for SR/TTC, bootstrap for TP/rTP).</p>{overall}<p class="caveats">{escape(TABLE_I_CAVEATS)}</p><div class="plots">{plots_html(plots, base)}</div>'
         f"<details><summary>Per task</summary>{tasks}</details><h2>Episodes</h2>\n{episodes}\n</body></html>\n"
     )

@@ -38,9 +38,19 @@ class FilterAnswer(_Answer):
 
 
 class PlanAnswer(_Answer):
-    """Answer to planning: a short reasoning and one skill call."""
+    """Answer to planning: free reasoning first, then one skill call."""
 
-    reasoning: str = Field(description="One or two short sentences on why this action.")
+    reasoning: str = Field(description="The model's reasoning towards this action, at any length.")
+    skill: str = Field(description="Name of the skill to call.")
+    arguments: list[str] = Field(description="Arguments in order: room and/or object names; empty for done().")
+
+
+class MomaPlanAnswer(_Answer):
+    """Answer to MoMa-LLM's planning prompt: Analysis, Reasoning, Command (its answer format), the
+    command written as skill and arguments so that a schema can hold it."""
+
+    analysis: str = Field(description="Where the objects of interest could be and which actions lead there.")
+    reasoning: str = Field(description="Why the next action matters for the task.")
     skill: str = Field(description="Name of the skill to call.")
     arguments: list[str] = Field(description="Arguments in order: room and/or object names; empty for done().")
 

@@ -106,6 +106,7 @@ class ChatClient:
         seed: int | None = None,
         prices: Mapping[str, ModelPrice] | None = None,
         limiter: LLMConcurrencyLimiter | None = None,
+        name_enums: bool = False,
     ) -> None:
         if cache is None and cache_mode in (CacheMode.ON, CacheMode.REFRESH, CacheMode.REPLAY):
             raise ValueError(f"cache mode {cache_mode.value!r} needs a cache")
@@ -117,6 +118,8 @@ class ChatClient:
         self.seed = seed
         self.prices = dict(prices or {})
         self.usage = UsageMeter()
+        self.name_enums = name_enums
+        """Whether planners send answer schemas that enumerate the valid names (:mod:`more_agent.llm.name_enums`)."""
         self.limiter = limiter or llm_limiter()
         """Held around each request: one cap on concurrent calls across evaluation workers (default:
         the limiter the harness installed in this worker process)."""

@@ -54,6 +54,17 @@ class StructuredOutput(StrEnum):
     """Never send it; always parse the JSON out of the text."""
 
 
+class NameEnums(StrEnum):
+    """Whether answer schemas enumerate the names a request may use (:mod:`more_agent.llm.name_enums`)."""
+
+    AUTO = "auto"
+    """For llama.cpp (its grammar always applies), not for OpenAI-compatible endpoints."""
+    ON = "on"
+    """For every backend (OpenAI-compatible servers with ``json_schema`` structured output)."""
+    OFF = "off"
+    """Never: the schema fixes the shape, the re-ask path catches unknown names."""
+
+
 class ModelPrice(BaseModel):
     """Price of one model in USD per million tokens."""
 
@@ -73,7 +84,8 @@ class LLMConfig(BaseModel):
     )
     room_model: str | None = Field(
         default=None,
-        description="Cheaper model for room classification, same endpoint (paper: gpt-3.5-turbo); None = same model.",
+        description="LLM for room classification (paper: gpt-3.5-turbo): a spec such as 'openai:gpt-3.5-turbo', or a "
+        "model name on the planning model's endpoint; None = the planning model (--room-llm).",
     )
     base_url: str | None = Field(
         default=None,
@@ -100,6 +112,10 @@ class LLMConfig(BaseModel):
     )
     structured_output: StructuredOutput = Field(
         default=StructuredOutput.AUTO, description="Send JSON schemas as response_format: auto, always or never."
+    )
+    name_enums: NameEnums = Field(
+        default=NameEnums.AUTO,
+        description="Enumerate valid skill, room and object names in answer schemas: auto (llama.cpp only), on, off.",
     )
     cache_mode: CacheMode = Field(default=CacheMode.ON, description="Response cache use: on, refresh, off, replay.")
     cache_path: Path = Field(default=C.DEFAULT_CACHE_PATH, description="sqlite file of the response cache.")
@@ -185,6 +201,7 @@ def _env_settings(env: Mapping[str, str]) -> dict[str, object]:
         C.ENV_API_KEY: "api_key",
         C.ENV_LLM: "llm",
         C.ENV_ROOM_MODEL: "room_model",
+        C.ENV_NAME_ENUMS: "name_enums",
         C.ENV_CACHE_PATH: "cache_path",
         C.ENV_CACHE_MODE: "cache_mode",
     }

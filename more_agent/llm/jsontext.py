@@ -13,7 +13,9 @@ from typing import Any
 from pydantic import BaseModel
 
 _FENCE = re.compile(r"```(?:json|JSON)?\s*\n?(.*?)```", re.S)
-_DECODER = json.JSONDecoder()
+_DECODER = json.JSONDecoder(strict=False)
+"""Accepts raw control characters (a newline) inside strings: llama.cpp's JSON grammar lets a model
+write them in its reasoning, which the strict standard forbids."""
 
 
 def _first_object(text: str) -> dict[str, Any] | None:
@@ -34,7 +36,7 @@ def extract_json(text: str) -> dict[str, Any] | None:
     """The JSON object in ``text``: the whole text, else inside a code fence, else the first one in prose."""
     stripped = text.strip()
     try:
-        value = json.loads(stripped)
+        value = _DECODER.decode(stripped)
     except json.JSONDecodeError:
         value = None
     if isinstance(value, dict):

@@ -18,8 +18,8 @@ MAX_ANSWER_CHARS = 16_000
 MAX_NAME_CHARS = 200
 """Longest skill, room or object name in an answer; real scene names are under 60 characters."""
 
-MAX_REASONING_CHARS = 1_000
-"""The answer's free-text reasoning is kept up to this length."""
+MAX_REASONING_CHARS = 8_000
+"""The answer's free-text reasoning is kept up to this length (answers may reason at length: half an answer)."""
 
 MAX_FEEDBACK_CHARS = 500
 """Feedback of one action as the next prompt and the history show it."""

@@ -159,7 +159,10 @@ class LlamaCppBackend:
             )
         extra: dict[str, Any] = {}
         if request.schema is not None:
-            extra["response_format"] = {"type": "json_object", "schema": bounded_schema(request.schema)}
+            extra["response_format"] = {
+                "type": "json_object",
+                "schema": bounded_schema(request.schema, request.max_tokens),
+            }
         if request.seed is not None:
             extra["seed"] = request.seed
         out = self.llama().create_chat_completion(

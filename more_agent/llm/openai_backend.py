@@ -178,7 +178,10 @@ class OpenAIBackend:
                 "json_schema": {"name": request.schema_name or "answer", "schema": request.schema, "strict": True},
             }
         elif schema_format == "json_object":
-            extra["response_format"] = {"type": "json_object", "schema": bounded_schema(request.schema)}
+            extra["response_format"] = {
+                "type": "json_object",
+                "schema": bounded_schema(request.schema, request.max_tokens),
+            }
         if request.seed is not None:
             extra["seed"] = request.seed
         try:

@@ -20,7 +20,7 @@ from more_agent.llm.completion import ChatMessage
 from more_agent.records import DEFAULT_HISTORY, HISTORY_MODES, HistoryMode
 from more_agent.skills import SKILLS, Skill
 
-PROMPT_NAMES = ("room", "filter", "plan")
+PROMPT_NAMES = ("room", "filter", "plan", "moma_plan")
 VLM_PROMPT_NAMES = ("bumble_plan", "bumble_landmark", "bumble_object", "bumble_explore", "bumble_verify")
 """The BUMBLE baselines' prompts (:mod:`more_agent.planners.vlm_prompts` builds their messages with images)."""
 HISTORY_LAST_N = 5

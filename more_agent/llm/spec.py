@@ -12,6 +12,7 @@ from more_agent.llm.client import Backend, ChatClient
 from more_agent.llm.config import CacheMode, LLMConfig
 from more_agent.llm.errors import BadLLMSpec
 from more_agent.llm.local_models import BUNDLED_MODELS, gguf_path, is_bundled
+from more_agent.llm.name_enums import uses_name_enums
 from more_agent.redaction import has_credentials
 
 BACKEND_KINDS = ("openai", "llamacpp")
@@ -65,9 +66,14 @@ def llm_configured(config: LLMConfig, cli_spec: str | None = None) -> bool:
 
 
 def room_spec(spec: LLMSpec, config: LLMConfig) -> LLMSpec:
-    """The LLM for room classification: ``config.room_model`` on the same endpoint (openai), else ``spec``."""
-    if spec.kind == "openai" and config.room_model:
-        return LLMSpec(kind="openai", model=config.room_model)
+    """The LLM for room classification (the paper: GPT-3.5 Turbo, GPT-4o for the rest): ``config.room_model``
+    as a full spec (``openai:gpt-3.5-turbo``, ``llamacpp:smollm2``), or a bare model name on the planning
+    model's OpenAI-compatible endpoint; the planning model ``spec`` when it is unset."""
+    room = config.room_model
+    if room and room.partition(":")[0].strip().lower() in BACKEND_KINDS:
+        return parse_llm_spec(room)
+    if spec.kind == "openai" and room:
+        return LLMSpec(kind="openai", model=room)
     return spec
 
 
@@ -91,12 +97,14 @@ def make_client(spec: LLMSpec | str, config: LLMConfig) -> ChatClient:
     if config.cache_mode is not CacheMode.OFF:
         check_cache_path(config.cache_path, write=config.cache_mode is not CacheMode.REPLAY)
         cache = ResponseCache(config.cache_path, busy_timeout_s=config.cache_busy_timeout_s)
+    backend = make_backend(spec, config)
     return ChatClient(
-        make_backend(spec, config),
+        backend,
         cache=cache,
         cache_mode=config.cache_mode,
         temperature=config.temperature,
         max_tokens=config.max_tokens,
         seed=config.seed,
         prices=config.prices,
+        name_enums=uses_name_enums(config, backend.kind),
     )

@@ -76,6 +76,7 @@ class UsageMeter:
     images: int = 0
     image_bytes: int = 0
     image_tokens: int = 0
+    reasoning_tokens: int = 0
     unpriced_models: set[str] = field(default_factory=set)
 
     def add(self, completion: Completion) -> None:
@@ -88,6 +89,7 @@ class UsageMeter:
         self.images += completion.images
         self.image_bytes += completion.image_bytes
         self.image_tokens += completion.image_tokens
+        self.reasoning_tokens += reasoning_tokens(completion)
         if not completion.cost_known:
             self.unpriced_models.add(completion.model)
 
@@ -102,4 +104,19 @@ class UsageMeter:
             "images": self.images,
             "image_bytes": self.image_bytes,
             "image_tokens": self.image_tokens,
+            "reasoning_tokens": self.reasoning_tokens,
         }
+
+
+REASONING_FIELDS = ("analysis", "reasoning")
+"""Free-text answer fields a model reasons in before its command (:data:`more_agent.llm.grammar.FREE_TEXT_FIELDS`)."""
+
+
+def reasoning_tokens(completion: Completion) -> int:
+    """Answer tokens spent on reasoning: the answer's tokens in the share of its characters that its
+    free-text fields hold (servers count tokens per answer, not per field)."""
+    parsed, text = completion.parsed, completion.text
+    if not parsed or not text:
+        return 0
+    chars = sum(len(v) for k in REASONING_FIELDS if isinstance(v := parsed.get(k), str))
+    return round(completion.usage.completion_tokens * min(1.0, chars / len(text)))

@@ -8,12 +8,16 @@ the planner reasons over images instead of a scene text.
   0 (floor, carpet, lawn, driveway, walls, windows) is background and never marked. Objects are the
   scene graph's (its labels, states and relations describe them); the graph also gives the map the
   subpolicies drive on and the unexplored areas (frontiers).
-- **Visual memory**: every rendered frame is offered to a :class:`VisualMemory` buffer (one frame per
-  0.5 m or 30 degrees, the initial turn included). Long-term memory: every failed action with its
-  feedback; short-term: the last five actions (the history text MORE's planner gets).
+- **Frame buffer**: every rendered frame is offered to a :class:`VisualMemory` buffer (one frame per
+  0.5 m or 30 degrees, the initial turn included), for the landmark and exploration questions.
+- **BUMBLE's memories** (:mod:`~more_agent.planners.bumble_memory`): short-term, the episode's steps
+  each with the annotated view seen then (downscaled, the last eight with images); long-term, failure
+  summaries of earlier trials of the task from the file ``$MORE_AGENT_BUMBLE_MEMORY`` names (each
+  failed step is appended to it).
 - **Deciding**: the VLM gets the task, the current view annotated set-of-mark style with its marked
   objects listed (with their distance from the robot, as BUMBLE's selector gets them), the memories
-  (each past action with its subtask) and the skills, and answers a subtask and a skill.
+  and the skills, analyses step by step (whether the object is within reach included) and answers a
+  subtask and a skill.
 - **Reaching an object** (``navigate``, ``go_to_and_*``): the landmark step (BUMBLE's
   ``goto_landmark``) shows buffer frames with their object lists and asks for a frame; the object step
   (``navigate_to_point_on_ground``) shows that frame with numbered marks and asks for a mark.
@@ -21,8 +25,9 @@ the planner reasons over images instead of a scene text.
   the closest area seen in it. The VLM then sees the frames acquired during the exploration and says
   whether the subtask was achieved: that verdict is the action's success flag and feedback (so an
   exploration that found nothing enters the long-term memory of failed actions).
-- **``bumble-filter``**: MORE's filter (its prompt and parser) on the objects the VLM could be shown;
-  only the kept objects are marked and listed, and frames are chosen to show them.
+- **``bumble-filter``**: MORE's filter (its prompt and parser) on the objects annotated in the
+  current view (the paper's "applied to the objects that get annotated in the current view"); only
+  the kept ones are marked and listed in it. Memory frames are annotated unfiltered.
 
 Requests hold at most ``MemoryConfig.max_images`` buffer frames (8), chosen to show as many
 candidate objects as possible (greedy cover) or, for exploration verdicts, evenly spread; the step
@@ -45,8 +50,17 @@ from pydantic import BaseModel, ConfigDict, Field
 from more_agent.llm import InvalidAnswer, LLMClient, ask_validated
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
+from more_agent.llm.name_enums import constrains_names, with_name_enums
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace, needed
+from more_agent.planners.bumble_memory import (
+    FailureStore,
+    PastStep,
+    downscaled_png,
+    failure_summary,
+    long_term_message,
+    short_term_messages,
+)
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, room_names, scene_view
@@ -79,7 +93,7 @@ from more_agent.planners.vlm_prompts import (
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
 from more_agent.robot import ActionResult, Frame
 from more_agent.scene_graph import ObjectNode, SceneGraph
-from more_agent.skills import INVALID
+from more_agent.skills import INVALID, SKILLS
 
 log = logging.getLogger(__name__)
 
@@ -109,16 +123,6 @@ BUMBLE_CONFIGS: dict[str, BumbleConfig] = {
     "bumble-filter": BumbleConfig(name="bumble-filter", filtering=True),
 }
 """The paper's two BUMBLE planners by name."""
-
-
-@dataclass(frozen=True)
-class PastAction:
-    """An executed action as the step prompt's history shows it: 'subtask -> skill(target)'."""
-
-    name: str
-    arguments: list[str]
-    ok: bool
-    feedback: str
 
 
 @dataclass
@@ -152,8 +156,12 @@ class BumblePlanner:
         self.task = ""
         self.history: list[ActionRecord] = []
         self.history_mode: HistoryMode = DEFAULT_HISTORY
-        self.subtasks: list[str] = []
-        """The subtask of each action in ``history``."""
+        self.past: list[PastStep] = []
+        """Short-term memory: the episode's steps with their views."""
+        self.store = FailureStore.from_env()
+        """Long-term memory file, if one is configured."""
+        self.long_term: list[str] = []
+        """Failure summaries of earlier trials of the task."""
         self.feedback = ""
         self.graph: SceneGraph | None = None
         self.descriptions: dict[str, str] = {}
@@ -176,7 +184,9 @@ class BumblePlanner:
 
         self.body.on_frame = on_frame
         self.task = context.goal.text
-        self.history, self.subtasks, self.feedback, self.history_mode = [], [], "", context.history
+        self.history, self.feedback, self.history_mode = [], "", context.history
+        self.past = []
+        self.long_term = self.store.summaries(self.task) if self.store is not None else []
         self.calls.new_episode()
         self.body.start()
 
@@ -193,7 +203,10 @@ class BumblePlanner:
     def decide(self) -> HighLevelAction:
         """Step decision, then the skill's parameter steps; ``invalid`` when an answer stays unusable."""
         try:
-            skill, subtask = self._ask(self._step_messages(), StepAnswer, parse_step, "plan")
+            schema = StepAnswer
+            if constrains_names(self.client):
+                schema = with_name_enums(StepAnswer, {"skill": [s.name for s in SKILLS]})
+            skill, subtask = self._ask(self._step_messages(), schema, parse_step, "plan")
             if skill == DONE:
                 return HighLevelAction(name=DONE, note=subtask)
             target = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
@@ -208,9 +221,18 @@ class BumblePlanner:
         """Run the subpolicy (explorations get the VLM's verdict as feedback)."""
         result = self._run(action)
         self.feedback = append_action(self.history, action, result)
-        self.subtasks.append(action.note if action.name != INVALID else "")
         self.step_log.subtask = action.note
+        self._remember(action, self.history[-1])
         return result
+
+    def _remember(self, action: HighLevelAction, done: ActionRecord) -> None:
+        """The step into the short-term memory; a failure also into the long-term memory file."""
+        view = self.step_log.pictures.get("view")
+        subtask = action.note if action.name != INVALID else ""
+        step = PastStep(subtask, action.name, done.ok, done.feedback, downscaled_png(view) if view else None)
+        self.past.append(step)
+        if not step.ok and self.store is not None:
+            self.store.add(self.task, failure_summary(step))
 
     def step_trace(self) -> StepTrace:
         """The step's action, subtask, the frames offered and picked (its ``steps.jsonl`` line) and the VLM's images."""
@@ -230,13 +252,13 @@ class BumblePlanner:
         return self.calls.usage()
 
     # -- what the VLM sees ------------------------------------------------------------------------
-    def markable(self, instance_ids: Collection[int]) -> list[str]:
+    def markable(self, instance_ids: Collection[int], *, filtered: bool = False) -> list[str]:
         """Object ids the VLM may be shown among ``instance_ids``, sorted by label: in the graph, not
-        held, kept by the filter under ``bumble-filter``."""
+        held, and with ``filtered`` (the current view) kept by the filter under ``bumble-filter``."""
         graph = self._graph()
         by_instance = {o.instance_id: o for o in graph.objects.values() if not o.held and o.id in self.descriptions}
         objs = [by_instance[i] for i in instance_ids if i in by_instance]
-        if self.relevant is not None:
+        if filtered and self.relevant is not None:
             objs = [o for o in objs if o.id in self.relevant]
         return [o.id for o in sorted(objs, key=lambda o: o.label)]
 
@@ -259,26 +281,25 @@ class BumblePlanner:
     # -- the questions ----------------------------------------------------------------------------
     def _step_messages(self) -> list[ChatMessage]:
         frame = self._current()
-        ids = self.markable(set(np.unique(frame.instance).tolist()) - {0})
+        ids = self.markable(self._in_view(), filtered=True)
         view, marked = self.marked_picture(frame.rgb, frame.instance, ids, "Current view:")
         self.step_log.pictures["view"] = view.png
         graph = self._graph()
         xy = graph.robot.position
         objects = [f"{self.descriptions[o]}, {math.dist(xy, graph.objects[o].position[:2]):.1f} m away" for o in marked]
-        past = [
-            PastAction(f"{subtask} -> {a.name}" if subtask else a.name, a.arguments, a.ok, a.feedback)
-            for a, subtask in zip(self.history, self.subtasks, strict=True)
-        ]
         held = graph.held_object
         return step_messages(
             task=self.task,
             view=view,
             objects=objects,
             held=held.label if held is not None else None,
-            history=past,
             feedback=self.feedback,
-            history_mode=self.history_mode,
+            memory=[*long_term_message(self.long_term), *short_term_messages(self.past)],
         )
+
+    def _in_view(self) -> set[int]:
+        """Instance ids in the current view, background (0) left out."""
+        return set(np.unique(self._current().instance).tolist()) - {0}
 
     def _object_target(self, subtask: str) -> ObjectNode | Unresolved:
         """Landmark step (which frame), then object step (which mark in it)."""
@@ -364,8 +385,11 @@ class BumblePlanner:
         return achieved, f"{verdict}: {why}" if why else verdict
 
     def _filter(self, view: SceneView) -> set[str]:
-        """MORE's filter on every object the VLM could be shown, as one room; all kept when the answer is unusable."""
-        objects = tuple(o for r in view.rooms for o in r.objects)
+        """MORE's filter on the objects of the current view, as one room; all kept when the answer is unusable."""
+        graph, in_view = self._graph(), self._in_view()
+        objects = tuple(
+            o for r in view.rooms for o in r.objects if any(graph.objects[i].instance_id in in_view for i in o.ids)
+        )
         flat = SceneView(
             rooms=(RoomText(OBSERVED_ROOM, "", objects, False),),
             robot_room=OBSERVED_ROOM,

@@ -9,8 +9,12 @@ feedback, then run that subpolicy. Planners differ only in their
 :class:`LLMPlannerConfig`:
 
 - ``more``: filtering, alphabetical instance ids, spatial relations;
-- ``moma-llm``: no filtering, objects by class, no spatial relations;
+- ``moma-llm``: no filtering, MoMa-LLM's own scene encoding and answer format
+  (:mod:`~more_agent.planners.moma_encoding`), objects by class, no spatial relations;
 - ``moma-llm-sr``: ``moma-llm`` with spatial relations.
+
+The planning request of each (:mod:`~more_agent.planners.plan_prompts`) enumerates the valid names in
+its answer schema when the client asks for name enums (llama.cpp by default).
 
 The class implements the :class:`~more_agent.planners.base.Planner` protocol. LLM transport errors
 (timeouts, a server gone, a replay miss) propagate as :class:`~more_agent.llm.errors.LLMError` for
@@ -34,7 +38,6 @@ from more_agent.llm import (
     LLMClient,
     LLMConfig,
     LLMConfigError,
-    PlanAnswer,
     RoomLabelAnswer,
     ask_validated,
     configured_llm,
@@ -42,24 +45,24 @@ from more_agent.llm import (
     load_llm_config,
     make_client,
     parse_filter_answer,
-    parse_plan_answer,
     parse_room_label,
-    plan_messages,
     room_messages,
     room_spec,
 )
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
+from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, with_name_enums
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace, needed
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
+from more_agent.planners.plan_prompts import PlanState, PromptKind, plan_request
 from more_agent.planners.policies import Embodiment, PolicyConfig, pick_target, run_skill
 from more_agent.planners.targets import Area, Target, Unresolved
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
 from more_agent.robot import ActionResult
 from more_agent.scene_graph import SceneGraph
-from more_agent.skills import INVALID, SKILLS, SKILLS_BY_NAME
+from more_agent.skills import INVALID, SKILLS_BY_NAME
 from more_agent.vocabulary import FLOOR, ROOM_TYPES
 
 log = logging.getLogger(__name__)
@@ -73,6 +76,7 @@ class LLMPlannerConfig(BaseModel):
     name: str = Field(description="Planner name as registered, e.g. 'more'.")
     filtering: bool = Field(description="Ask the LLM for the task-relevant subgraph before planning (MORE).")
     language: LanguageOptions = Field(description="Instance ids and spatial relations in the scene text.")
+    prompt: PromptKind = Field(default="more", description="Planning prompt: MORE's or MoMa-LLM's own encoding.")
     max_reasks: int = Field(
         default=2, ge=0, description="Re-asks after an invalid answer before it counts as an invalid action."
     )
@@ -86,10 +90,16 @@ PLANNER_CONFIGS: dict[str, LLMPlannerConfig] = {
         name="more", filtering=True, language=LanguageOptions(instance_ids=True, spatial_relations=True)
     ),
     "moma-llm": LLMPlannerConfig(
-        name="moma-llm", filtering=False, language=LanguageOptions(instance_ids=False, spatial_relations=False)
+        name="moma-llm",
+        filtering=False,
+        language=LanguageOptions(instance_ids=False, spatial_relations=False),
+        prompt="moma",
     ),
     "moma-llm-sr": LLMPlannerConfig(
-        name="moma-llm-sr", filtering=False, language=LanguageOptions(instance_ids=False, spatial_relations=True)
+        name="moma-llm-sr",
+        filtering=False,
+        language=LanguageOptions(instance_ids=False, spatial_relations=True),
+        prompt="moma",
     ),
 }
 """The paper's LLM planners by name."""
@@ -103,6 +113,8 @@ class LLMClients:
     room: LLMClient
     spec: str
     """The planning LLM as a spec, e.g. 'openai:gpt-4o' (for the episode record)."""
+    room_spec: str = ""
+    """The room-classification LLM as a spec ('' = the planning LLM), for the episode record."""
 
 
 def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients:
@@ -115,7 +127,8 @@ def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients
         )
     rooms = room_spec(spec, config)
     plan = make_client(spec, config)
-    return LLMClients(plan=plan, room=plan if rooms == spec else make_client(rooms, config), spec=str(spec))
+    room = plan if rooms == spec else make_client(rooms, config)
+    return LLMClients(plan=plan, room=room, spec=str(spec), room_spec=str(rooms))
 
 
 class LLMPlanner:
@@ -124,6 +137,8 @@ class LLMPlanner:
     def __init__(self, config: LLMPlannerConfig, clients: LLMClients) -> None:
         self.name = config.name
         self.llm: str | None = clients.spec
+        self.room_llm: str | None = clients.room_spec or clients.spec
+        """The LLM that labels rooms (the episode record's ``room_llm``)."""
         self.config = config
         self.calls = CallLog()
         """Every LLM call (room labels, filter, plan, re-asks): the episode's usage, the step's exchanges."""
@@ -131,6 +146,7 @@ class LLMPlanner:
             plan=RecordingClient(clients.plan, self.calls),
             room=RecordingClient(clients.room, self.calls),
             spec=clients.spec,
+            room_spec=clients.room_spec,
         )
         self.body: Embodiment | None = None
         self.task = ""
@@ -141,13 +157,16 @@ class LLMPlanner:
         self.view: SceneView | None = None
         """The step's full scene text."""
         self.planning_view: SceneView | None = None
-        """The scene text the step planned on (the filtered one under filtering)."""
+        """The scene view the step planned on (the filtered one under filtering)."""
+        self.planning_scene = ""
+        """The scene text of the step's planning prompt (MoMa-LLM's encoding under ``prompt='moma'``)."""
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
         self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping)
-        self.task = context.goal.text
+        described = context.goal.class_text if self.config.prompt == "moma" else ""
+        self.task = described or context.goal.text
         self.history, self.history_mode, self.feedback = [], context.history, ""
         self.calls.new_episode()
         self.body.start()
@@ -162,22 +181,15 @@ class LLMPlanner:
         """Filter (MORE) and plan: the next subpolicy call, or ``invalid`` when no valid answer came."""
         view = self._view()
         planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
-        messages = plan_messages(
-            task=self.task,
-            scene=planning_view.text(),
-            robot_room=view.robot_room,
-            held_object=view.held,
-            history=self.history,
-            feedback=self.feedback,
-            history_mode=self.history_mode,
-        )
-        rooms, objects = [r.name for r in view.rooms], view.object_names()
+        state = PlanState(self.task, self._graph(), view, planning_view, self.history, self.feedback, self.history_mode)
+        request = plan_request(self.config.prompt, state, name_enums=constrains_names(self.clients.plan))
+        self.planning_scene = request.scene
         try:
             answer = ask_validated(
                 self.clients.plan,
-                messages,
-                PlanAnswer,
-                lambda a: parse_plan_answer(a, SKILLS, rooms, objects),
+                request.messages,
+                request.schema,
+                request.validate,
                 max_reasks=self.config.max_reasks,
                 purpose="plan",
             )
@@ -200,11 +212,10 @@ class LLMPlanner:
     def step_trace(self) -> StepTrace:
         """The step's scene texts, action and LLM exchanges (its ``steps.jsonl`` line) and scene graph."""
         view = self._view()
-        planning = self.planning_view or view
         log_line = {
             "action": self.history[-1].model_dump(),
             "scene": view.text(),
-            "planning_scene": planning.text(),
+            "planning_scene": self.planning_scene or (self.planning_view or view).text(),
             "robot_room": view.robot_room,
             "exchanges": [e.to_json() for e in self.calls.exchanges],
         }
@@ -219,6 +230,9 @@ class LLMPlanner:
         """Room labels for regions without one that have objects (one call each with the room model);
         a region whose answer stays invalid is left unlabelled and asked again next step."""
         labels: dict[str, str] = {}
+        schema = RoomLabelAnswer
+        if constrains_names(self.clients.room):
+            schema = with_name_enums(RoomLabelAnswer, {"room": self.config.room_types})
         for rid, region in sorted(graph.regions.items()):
             objects = [o for o in graph.objects_in(rid) if o.category != "door"]
             read = self.body.room_input(objects) if self.body is not None else [o.category for o in objects]
@@ -229,7 +243,7 @@ class LLMPlanner:
                 answer = ask_validated(
                     self.clients.room,
                     room_messages(names, self.config.room_types),
-                    RoomLabelAnswer,
+                    schema,
                     lambda a: parse_room_label(a, self.config.room_types),
                     max_reasks=self.config.max_reasks,
                     purpose="room",
@@ -304,7 +318,7 @@ def filter_view(
         answer = ask_validated(
             client,
             filter_messages(task, view.text()),
-            FilterAnswer,
+            filter_answer_with_names(view.names(), view.object_names()) if constrains_names(client) else FilterAnswer,
             lambda a: parse_filter_answer(a, view.names()),
             max_reasks=max_reasks,
             purpose="filter",

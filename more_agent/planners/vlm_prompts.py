@@ -21,8 +21,8 @@ from more_agent.errors import unknown_name_error
 from more_agent.llm.completion import ChatMessage
 from more_agent.llm.errors import InvalidAnswer
 from more_agent.llm.images import image_part, text_part
-from more_agent.llm.prompts import history_text, render_prompt, skill_api_text
-from more_agent.records import DEFAULT_HISTORY, HistoryMode
+from more_agent.llm.prompts import render_prompt, skill_api_text
+from more_agent.robot_spec import ROBOT
 from more_agent.skills import SKILLS
 
 
@@ -94,21 +94,22 @@ def step_messages(
     view: Picture,
     objects: Sequence[str],
     held: str | None,
-    history: Sequence[Any],
     feedback: str,
-    history_mode: HistoryMode = DEFAULT_HISTORY,
+    memory: Sequence[ChatMessage] = (),
 ) -> list[ChatMessage]:
-    """The step decision: task, annotated current view and its marked objects, memories, skills."""
-    messages = render_prompt(
+    """The step decision: task, annotated current view and its marked objects, skills; ``memory``
+    (BUMBLE's long- and short-term memory, :mod:`more_agent.planners.bumble_memory`) goes between
+    the instructions and the current view."""
+    system, *rest = render_prompt(
         "bumble_plan",
         task=task,
         skills=skill_api_text(SKILLS, vlm=True),
         objects=object_list(objects),
         held_object=held or "nothing",
-        history=history_text(history, history_mode),
         feedback=feedback or "none",
+        reach_m=f"{ROBOT.reach_m:g}",
     )
-    return with_pictures(messages, [view])
+    return [system, *memory, *with_pictures(rest, [view])]
 
 
 def frames_messages(prompt: str, *, task: str, subtask: str, pictures: Sequence[Picture]) -> list[ChatMessage]:

@@ -112,6 +112,9 @@ class TaskInstance:
     """How the description was written (``descriptions.DESCRIPTION_MODES``)."""
     description_template: str = ""
     """The description with ``$scope`` words where it names instances (``descriptions.description_template``)."""
+    class_description: str = ""
+    """The description naming instances by class ('the fridge'), for planners whose scene text shows
+    classes, not instance labels (MoMa-LLM: :func:`class_description`)."""
 
     def scope_objects(self) -> dict[str, ScopeObject]:
         """The filled bddl scope: every entry a ``ScopeObject``."""
@@ -227,6 +230,7 @@ def instantiate_in_scene(
     )
     _verify_init(instance)
     instance.description = task_description(instance)
+    instance.class_description = class_description(instance)
     instance.timings.update(bind=t_bind, place=t_place, clutter=t_clutter, instantiate=time.perf_counter() - t0)
     return instance
 
@@ -241,6 +245,18 @@ def task_description(instance: TaskInstance) -> str:
         instance.definition, instance.world, instance.scope, instance.descriptions
     )
     return SCOPE_WORD.sub(lambda m: _scope_phrase(instance, m.group(1)), instance.description_template)
+
+
+def class_description(instance: TaskInstance) -> str:
+    """The description with each scope object named by its class ('the fridge') rather than its label
+    ('fridge A'): what a scene text listing classes (MoMa-LLM's) can show. Floors and scopes without a
+    world object read as in :func:`task_description`."""
+
+    def phrase(scope: str) -> str:
+        obj = instance.world.objects.get(instance.scope.get(scope, ""))
+        return f"the {obj.category}" if obj is not None and obj.kind != "floor" else _scope_phrase(instance, scope)
+
+    return SCOPE_WORD.sub(lambda m: phrase(m.group(1)), instance.description_template)
 
 
 def _scope_phrase(instance: TaskInstance, scope: str) -> str:

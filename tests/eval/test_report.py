@@ -59,6 +59,9 @@ def test_markdown_and_csv_have_a_row_per_system_and_task() -> None:
         ("oracle", "t1"),
     ]
     assert float(rows[0]["SR"]) == 0.5 and float(rows[0]["SR_low"]) < 0.5 < float(rows[0]["SR_high"])
+    # beside Table I: what differs from the paper's setting (rendering, ground-truth captions, magic reach)
+    caveats = md.split("## Failure causes")[0]
+    assert "flat-shaded boxes" in caveats and "ground-truth" in caveats and "magic actions" in caveats
 
 
 def test_rtp_cells_say_n_when_episodes_have_none(tmp_path: Path) -> None:
@@ -71,6 +74,7 @@ def test_rtp_cells_say_n_when_episodes_have_none(tmp_path: Path) -> None:
     assert (rows["ALL"]["rTP"], rows["ALL"]["n_rTP"], rows["t2"]["rTP"], rows["t2"]["n_rTP"]) == ("1.000000", "1", "", "0")
     html = render_report([SourcedRecord(blind, tmp_path)])
     assert "rTP n/a" in html and "<td>n/a</td>" in html
+    assert '<p class="caveats">' in html and "flat-shaded boxes" in html.split("<h2>Episodes</h2>")[0]
 
 
 def test_html_escapes_all_record_text(tmp_path: Path) -> None:

@@ -42,7 +42,7 @@ def test_answer_with_usage_cost_and_schema(fake_openai: FakeOpenAIServer, llm_co
     assert req.headers["authorization"] == f"Bearer {llm_config.api_key_value()}"
     assert client.usage.totals() == {
         "calls": 1, "prompt_tokens": 1000, "completion_tokens": 200, "cost_usd": out.cost_usd, "cache_hits": 0,
-        "images": 0, "image_bytes": 0, "image_tokens": 0,
+        "images": 0, "image_bytes": 0, "image_tokens": 0, "reasoning_tokens": 0,
     }
 
 

@@ -5,13 +5,17 @@ from __future__ import annotations
 import json
 
 from more_agent.llm import FilterAnswer, PlanAnswer, RoomLabelAnswer
-from more_agent.llm.grammar import MAX_ITEMS, NAME_CHARS, TEXT_CHARS, bounded_schema
+from more_agent.llm.answers import MomaPlanAnswer
+from more_agent.llm.grammar import MAX_ITEMS, NAME_CHARS, bounded_schema, free_text_chars
 from more_agent.llm.jsontext import json_schema_of
 
 
-def test_free_text_names_and_lists_get_their_bounds() -> None:
-    plan = bounded_schema(json_schema_of(PlanAnswer))["properties"]
-    assert plan["reasoning"]["maxLength"] == TEXT_CHARS and plan["skill"]["maxLength"] == NAME_CHARS
+def test_names_and_lists_get_their_bounds_and_reasoning_its_share_of_the_answer() -> None:
+    plan = bounded_schema(json_schema_of(PlanAnswer), max_tokens=1024)["properties"]
+    assert plan["reasoning"]["maxLength"] == free_text_chars(1024) == 1000 and plan["skill"]["maxLength"] == NAME_CHARS
+    moma = bounded_schema(json_schema_of(MomaPlanAnswer), max_tokens=512)["properties"]
+    assert moma["analysis"]["maxLength"] == moma["reasoning"]["maxLength"] == (512 - 256) * 2 // 2
+    assert free_text_chars(100) == 200 and free_text_chars(100_000) == 1000  # the floor, and llama.cpp's ceiling
     assert plan["arguments"]["maxItems"] == MAX_ITEMS and plan["arguments"]["items"]["maxLength"] == NAME_CHARS
 
 

@@ -18,7 +18,14 @@ from more_agent.llm import (
     parse_plan_answer,
 )
 from more_agent.llm.errors import OversizeAnswer
-from more_agent.llm.limits import MAX_ANSWER_CHARS, MAX_ECHO_CHARS, MAX_ERROR_CHARS, MAX_NAME_CHARS, clip
+from more_agent.llm.limits import (
+    MAX_ANSWER_CHARS,
+    MAX_ECHO_CHARS,
+    MAX_ERROR_CHARS,
+    MAX_NAME_CHARS,
+    MAX_REASONING_CHARS,
+    clip,
+)
 from more_agent.skills import SKILLS
 from tests.fakes.openai_server import FakeOpenAIServer, Reply, Status
 
@@ -66,7 +73,7 @@ def test_overlong_names_are_rejected_without_echo() -> None:
 
 def test_reasoning_is_clipped() -> None:
     planned = _validate({"reasoning": "r" * 50_000, "skill": "done", "arguments": []})
-    assert len(planned.reasoning) < 1_100  # type: ignore[attr-defined]
+    assert MAX_REASONING_CHARS <= len(planned.reasoning) < MAX_REASONING_CHARS + 100  # type: ignore[attr-defined]
 
 
 def test_server_error_text_is_clipped(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:

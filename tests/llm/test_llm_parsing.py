@@ -121,3 +121,12 @@ def test_prices() -> None:
     assert price_of("gpt-4o-mini-2024-07-18") == ModelPrice(input_per_m=0.15, output_per_m=0.60)
     assert price_of("qwen2.5") is None
     assert price_of("qwen2.5", {"qwen2.5": ModelPrice(input_per_m=0, output_per_m=0)}) is not None
+
+
+def test_raw_newlines_inside_reasoning_are_accepted() -> None:
+    """llama.cpp's JSON grammar admits raw control characters in strings; a long analysis has them."""
+    from more_agent.llm import extract_json
+
+    text = '{"analysis": "line one\nline two", "reasoning": "r", "skill": "done", "arguments": []}'  # a raw newline
+    assert "\n" in text and extract_json(text) == {"analysis": "line one\nline two", "reasoning": "r", "skill": "done",
+                                                    "arguments": []}

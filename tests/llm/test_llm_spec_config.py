@@ -115,3 +115,7 @@ def test_room_classification_model() -> None:
     assert room_spec(spec, LLMConfig()) == spec
     local = LLMSpec(kind="llamacpp", model="m.gguf")
     assert room_spec(local, LLMConfig(room_model="gpt-3.5-turbo")) == local
+    # a full spec picks its own backend; an Ollama-style name with a colon stays a model name
+    assert room_spec(local, LLMConfig(room_model="openai:gpt-3.5-turbo")) == LLMSpec(kind="openai", model="gpt-3.5-turbo")
+    assert room_spec(spec, LLMConfig(room_model="llamacpp:smollm2")) == LLMSpec(kind="llamacpp", model="smollm2")
+    assert room_spec(spec, LLMConfig(room_model="llama3:8b")) == LLMSpec(kind="openai", model="llama3:8b")

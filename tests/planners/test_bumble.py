@@ -17,6 +17,7 @@ from more_agent.eval.episode_folder import STEPS_FILE, VLM_IMAGES_DIR
 from more_agent.llm import CacheMode, LLMConfig, make_client
 from more_agent.llm.images import LOW_DETAIL_TOKENS
 from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
+from more_agent.planners.bumble_memory import HISTORY_IMAGES, RIGHT, WRONG
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.skills import INVALID
@@ -70,17 +71,36 @@ def test_scripted_vlm_completes_the_episode(solved: Any) -> None:
 
 
 def test_requests_carry_decodable_pngs_of_the_frame_size_within_the_bound(solved: Any) -> None:
+    """Frames and current views at full size (at most max_images frames); earlier steps' views downscaled."""
     _, planner, server, _ = solved
     for r in server.requests:
-        images = request_images(r.body)
-        assert len(images) <= planner.config.memory.max_images
-        for png in images:
+        current = request_images({"messages": r.body["messages"][-1:]})
+        assert len(current) <= planner.config.memory.max_images
+        for png in current:
             assert _decode(png).shape == (256, 256, 3)
-        parts = r.body["messages"][-1]["content"]
-        if images:
-            assert all(p["image_url"]["detail"] == "low" for p in parts if p["type"] == "image_url")
+        remembered = request_images({"messages": r.body["messages"][1:-1]})
+        assert len(remembered) <= HISTORY_IMAGES and all(_decode(png).shape == (128, 128, 3) for png in remembered)
+        for m in r.body["messages"]:
+            if isinstance(m["content"], list):
+                assert all(p["image_url"]["detail"] == "low" for p in m["content"] if p["type"] == "image_url")
     kinds = {kind(r.body) for r in server.requests}
     assert {"plan", "landmark", "object"} <= kinds
+
+
+def test_short_term_memory_sends_every_earlier_step_with_its_view(solved: Any) -> None:
+    """BUMBLE's episodic history: step k's plan request holds the k-1 earlier steps, each answered by a verdict."""
+    record, _, server, _ = solved
+    plans = [r.body for r in server.requests if kind(r.body) == "plan" and "cannot be used" not in request_text(r.body)]
+    assert len(plans) == record.high_level_steps >= 3
+    for k, body in enumerate(plans):
+        steps = [m for m in body["messages"] if m["role"] == "user" and isinstance(m["content"], list)
+                 and m["content"][0]["text"].startswith("Step ")]
+        assert len(steps) == k and len(request_images({"messages": steps})) == min(k, HISTORY_IMAGES)
+        verdicts = [m["content"] for m in body["messages"] if m["role"] == "assistant"]
+        assert verdicts == [RIGHT if a.ok else WRONG for a in record.actions[:k]]
+        for step_message, action in zip(steps, record.actions, strict=False):
+            assert f"skill: {action.name}; success: {'yes' if action.ok else 'no'}" in step_message["content"][0]["text"]
+    assert "analyse step by step" in plans[0]["messages"][0]["content"] and "within reach" in plans[0]["messages"][0]["content"]
 
 
 def test_marks_sent_are_drawn_on_the_listed_objects(solved: Any) -> None:
@@ -174,8 +194,8 @@ def test_filtering_marks_only_task_objects_and_their_containers(tmp_path: Path) 
     task_objects = set(GOAL) | set(GOAL.values())
     listed = 0
     for r in server.requests:
-        if kind(r.body) in ("object", "plan"):
-            marks = (re.match(r"\d+: (.*)", line) for line in request_text(r.body).splitlines())  # not "N. history"
+        if kind(r.body) == "plan":  # the current view's annotations are filtered, memory frames are not
+            marks = (re.match(r"\d+: (.*)", line) for line in request_text(r.body).splitlines())
             entries = [m.group(1) for m in marks if m]
             holders = {m for e in entries for m in re.findall(r"\[inside ([^\]]+)\]", e)}
             assert {re.split(r" \[|, ", e)[0] for e in entries} <= task_objects | holders, entries

@@ -12,7 +12,7 @@ import pytest
 
 from more_agent.eval.episode import run_episode
 from more_agent.eval.episode_folder import STEPS_FILE
-from more_agent.llm import CacheMode, LLMConfig, make_client
+from more_agent.llm import CacheMode, LLMConfig, load_llm_config, make_client
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.sim.instantiate import instantiate
@@ -154,5 +154,22 @@ def test_moma_llm_names_objects_by_class_and_does_not_filter(tmp_path: Path) -> 
         record = _run(server, tmp_path, spec=SPEC.model_copy(update={"planner": "moma-llm"}))
     assert record.error is None and record.actions[0].ok and record.actions[0].feedback == "opened fridge A"
     assert not any("Remove every object" in r.body["messages"][0]["content"] for r in server.requests)
-    scene = server.requests[-1].body["messages"][-1]["content"].split("Scene:\n", 1)[1].split("\n\n", 1)[0]
-    assert "fridge [open]" in scene and "fridge A" not in scene and "bottom_cabinet (x2) [closed]" in scene
+    prompt = server.requests[-1].body["messages"]
+    scene = prompt[-1]["content"].split("Rooms and the objects found in them so far:\n", 1)[1].split("\nRooms with", 1)[0]
+    assert "opened fridge" in scene and "fridge A" not in scene and "closed bottom_cabinet, closed bottom_cabinet" in scene
+    assert "Analysis" not in prompt[0]["content"] and '"analysis"' in prompt[0]["content"]
+
+
+def test_room_llm_labels_rooms_and_is_recorded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """--room-llm: room prompts go to the room model (the paper's gpt-3.5-turbo), the rest to the planning model."""
+    from more_agent.commands._common import use_room_llm
+    from more_agent.planners.llm_planner import make_clients
+
+    with BrainServer(DoneBrain()) as server:
+        monkeypatch.delenv("MORE_AGENT_ROOM_MODEL", raising=False)
+        use_room_llm("openai:gpt-3.5-turbo")  # what the CLI option does
+        clients = make_clients("openai:gpt-4o", load_llm_config(overrides=_config(server, tmp_path).model_dump(exclude={"room_model"})))
+        record = run_episode(SPEC, planner=LLMPlanner(PLANNER_CONFIGS["more"], clients), out_dir=tmp_path / "ep")
+    assert record.error is None and (record.llm, record.room_llm) == ("openai:gpt-4o", "openai:gpt-3.5-turbo")
+    models = {("Possible room types" in r.body["messages"][-1]["content"], r.body["model"]) for r in server.requests}
+    assert models == {(True, "gpt-3.5-turbo"), (False, "gpt-4o")}

@@ -261,7 +261,10 @@ def test_scene_text_agrees_with_graph_and_history_every_step() -> None:
     for k, planner in enumerate(PLANNERS):
         for seed in range(k * EPISODES, (k + 1) * EPISODES):
             client = ScriptedClient(RandomBrain(seed))
-            agent = CheckedPlanner(PLANNER_CONFIGS[planner], LLMClients(client, client, "scripted"))
+            # MORE's plan prompt for every language view: the brain reads its scene text (MoMa-LLM's
+            # own prompt encodes the same view differently, tests/planners/test_moma_encoding.py).
+            config = PLANNER_CONFIGS[planner].model_copy(update={"prompt": "more"})
+            agent = CheckedPlanner(config, LLMClients(client, client, "scripted"))
             record = run_episode(EpisodeSpec(task=TASK, scene=str(TINY), seed=seed, planner=planner), planner=agent)
             assert record.error is None and record.traceback is None, record.traceback or record.error
             assert record.history == "paper"
