@@ -126,7 +126,7 @@ class SceneGraphBuilder:
         self._glimpse(depth, instance, K, T_world_cam, held)
         xy = (float(robot_xy[0]), float(robot_xy[1]))
         key = (round(xy[0] / self.config.viewpoint_spacing_m), round(xy[1] / self.config.viewpoint_spacing_m))
-        for iid in np.unique(instance[np.isfinite(depth)]).tolist():
+        for iid in np.flatnonzero(np.bincount(instance[np.isfinite(depth)].ravel())).tolist():  # ids in view
             if iid > 0:
                 self._viewpoints.setdefault(iid, {})[key] = xy
 
