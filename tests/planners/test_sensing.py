@@ -10,6 +10,7 @@ import pytest
 from more_agent.planners.policies import Embodiment
 from more_agent.planners.policies.embodiment import PolicyConfig
 from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
+from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.scene import load_scene
 
@@ -34,12 +35,13 @@ def test_the_angle_stays_below_the_cameras_field_of_view() -> None:
 @pytest.mark.parametrize("distance_m", [0.3, 0.6])
 def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_m: float) -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
-    body = Embodiment(inst.world, config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
+    robot = SimRobot(inst.world)
+    body = Embodiment(robot, config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
     body.sense()  # the frame where the robot stands
     frames: list[tuple[float, float]] = []
     body.on_frame = lambda frame: frames.append(body.xy)
     start = body.xy
-    yaw = body.world.robot.yaw
+    yaw = robot.pose[2]
     goal = (start[0] + 1.5 * math.cos(yaw), start[1] + 1.5 * math.sin(yaw))  # straight ahead: no turn on the way
     assert body.follow([start, goal])
     gaps = [math.dist(a, b) for a, b in zip([start, *frames], frames, strict=False)]
