@@ -94,7 +94,8 @@ def _imported(args: list[str]) -> set[str]:
 def test_listing_commands_import_only_what_they_use(args: list[str]) -> None:
     modules = _imported(args)
     assert "more_agent.cli" in modules
-    allowed = {"scipy.optimize"} if args[:2] == ["tasks", "show"] else set()  # instantiation matches scopes to objects
-    assert {m for m in modules for slow in SLOW_IMPORTS if slow not in allowed and (m == slow or m.startswith(slow + "."))} == set()
-    if args[0] == "--help" or args[1] == "list":
+    assert {m for m in modules for slow in SLOW_IMPORTS if m == slow or m.startswith(slow + ".")} == set()
+    if args[:2] != ["scene", "show"]:  # scene show generates the plan (scipy.ndimage, networkx)
         assert not any(m == "scipy" or m.startswith(("scipy.", "skimage", "networkx")) for m in modules)
+    if args[:2] == ["tasks", "show"]:  # shown as defined: nothing instantiated, no world built
+        assert not {"more_agent.sim.instantiate", "more_agent.sim.world", "more_agent.sim.scenes"} & modules

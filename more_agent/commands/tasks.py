@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.markup import escape
@@ -15,6 +15,9 @@ from more_agent.commands._common import (
     print_json,
     user_errors_exit_2,
 )
+
+if TYPE_CHECKING:
+    from more_agent.sim.tasks import TaskDefinition
 
 app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.", no_args_is_help=True)
 
@@ -62,44 +65,72 @@ def list_(
 @user_errors_exit_2
 def show(
     task: Annotated[str, typer.Argument(help="Activity name, e.g. putting_shopping_away.")],
-    scene: Annotated[str | None, typer.Option(help="Scene to instantiate in (default: drawn with the seed).")] = None,
+    scene: Annotated[
+        str | None, typer.Option(help="Instantiate in this scene (implies instantiating; default seed 0).")
+    ] = None,
     seed: Annotated[
-        int, typer.Option(min=0, max=MAX_SEED, help="Seed of the scene draw, scene generation and instantiation.")
-    ] = 0,
+        int | None,
+        typer.Option(
+            min=0,
+            max=MAX_SEED,
+            help="Instantiate with this seed (scene draw, scene generation, placement); without --seed or "
+            "--scene the task is shown as defined, not placed. --json always instantiates (seed 0 by default).",
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
-    """Show a task: description, objects, goal and suitable scenes, instantiated in a scene."""
-    from more_agent.sim.instantiate import instantiate
-    from more_agent.sim.tasks import (
-        EXCLUDED_SCENES,
-        check_scene_suits,
-        draw_scenes,
-        literal_text,
-        load_task,
-        suitable_scenes,
-    )
+    """Show a task: description, objects, goal and suitable scenes; with --seed or --scene, placed in a scene."""
+    from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, load_task, suitable_scenes
 
     if as_json:
-        print_json(_show_json(task, scene, seed))
+        print_json(_show_json(task, scene, seed or 0))
         return
     definition = load_task(task)
     scenes = suitable_scenes(task)
     console.print(task, style="bold", highlight=False, markup=False)
     console.print(f"suitable scenes ({len(scenes)}): {', '.join(scenes) or '-'}", highlight=False, markup=False)
-    drawn = draw_scenes(task, seed)
+    drawn = draw_scenes(task, seed or 0)
     console.print(
         f"episode scenes ({len(drawn)}, {', '.join(EXCLUDED_SCENES)} left out); "
-        f"drawn for seed {seed}: {drawn[0] if drawn else '-'}",
+        f"drawn for seed {seed or 0}: {drawn[0] if drawn else '-'}",
         highlight=False,
         markup=False,
     )
     if scene is not None:
         check_scene_suits(task, scene)
+    _print_definition(definition)
+    if seed is None and scene is None:
+        if scenes:
+            console.print("placed in a scene with --seed N or --scene S", highlight=False, markup=False)
+        return
+    if scenes or scene is not None:
+        _print_instance(task, scene, seed or 0)
+
+
+def _print_definition(definition: TaskDefinition) -> None:
+    """The task as bddl defines it: description template, goal, and each scope with its init literals."""
+    from more_agent.sim.tasks import category_phrase, literal_text
+
+    if definition.paper_description is not None:
+        console.print(f"paper description: {definition.paper_description}", highlight=False, markup=False)
     console.print("goal:", highlight=False)
     for lit in definition.goal:
         console.print(f"  {literal_text(lit)}", highlight=False, markup=False)
-    if not scenes and scene is None:
-        return
+    table = Table(title="scopes (bddl init)")
+    table.add_column("scope", no_wrap=True)
+    table.add_column("what")
+    table.add_column("initially")
+    for synset, scopes in definition.objects.items():
+        for s in scopes:
+            init = [" ".join([lit[0], *lit[2:]]) for lit in definition.init if len(lit) > 1 and lit[1] == s]
+            table.add_row(*map(escape, (s, category_phrase(synset), ", ".join(init) or "-")))
+    console.print(table)
+
+
+def _print_instance(task: str, scene: str | None, seed: int) -> None:
+    """The task instantiated: its scene, description, and where each scope's object is."""
+    from more_agent.sim.instantiate import instantiate
+
     inst = instantiate(task, scene, seed)
     console.print(
         f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False, markup=False

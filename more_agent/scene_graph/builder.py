@@ -130,22 +130,23 @@ class SceneGraphBuilder:
                 if iid in self._boxes:
                     self._remembered.add(iid)
             self._instances[iid] = info
-        self._pick_up_contents()
-        held = [iid for iid, info in self._instances.items() if info.held] + sorted(self._carried)
+        held_now = [iid for iid, info in self._instances.items() if info.held]
+        self._pick_up_contents(holding=bool(held_now))
+        held = held_now + sorted(self._carried)
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
         self._glimpse(depth, instance, K, T_world_cam, held)
         xy = (float(robot_xy[0]), float(robot_xy[1]))
         key = (round(xy[0] / self.config.viewpoint_spacing_m), round(xy[1] / self.config.viewpoint_spacing_m))
-        for iid in np.unique(instance[np.isfinite(depth)]).tolist():
+        for iid in np.flatnonzero(np.bincount(instance[np.isfinite(depth)].ravel())).tolist():  # ids in view
             if iid > 0:
                 self._viewpoints.setdefault(iid, {})[key] = xy
 
-    def _pick_up_contents(self) -> None:
-        """Update which instances ride on the held one (perception says what each rests on / in). Newly
-        carried ones leave the voxel map like the held one (seen in the robot's hand, they would map as
-        an obstacle where the robot stands) and are kept in the graph, travelling with the robot."""
+    def _pick_up_contents(self, *, holding: bool) -> None:
+        """Update which instances ride on the held one (perception says what each rests on / in), when
+        ``holding`` something. Newly carried ones leave the voxel map like the held one (seen in the
+        robot's hand, they would map as an obstacle where the robot stands) and are kept in the graph,
+        travelling with the robot."""
         carried: set[int] = set()
-        holding = any(info.held for info in self._instances.values())
         by_label = {info.label: iid for iid, info in self._instances.items()} if holding else {}
         for iid, info in self._instances.items() if holding else ():
             chain = info

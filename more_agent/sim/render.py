@@ -400,10 +400,10 @@ def instance_table(world: World, instance: np.ndarray) -> dict[int, dict[str, An
     """
     flat = instance.ravel()
     seen = set(np.flatnonzero(np.bincount(flat)).tolist()) - {0}
-    by_id: dict[int, WorldObject] = {o.instance_id: o for o in world.objects.values()}
     held = world.robot.held
     if held is not None:
         seen.add(world.objects[held].instance_id)
+    by_id = world.by_instance_ids(seen)
     new = [i for i in seen if not by_id[i].label and by_id[i].kind != "floor"]
     if new:  # first observations get their labels in reading order of the image
         ids, first = np.unique(flat, return_index=True)

@@ -22,6 +22,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -48,10 +49,14 @@ class TaskDefinition:
     """Synset -> its scope names, as bddl parsed them (``{'apple.n.01': ['apple.n.01_1']}``)."""
     init: list[ParsedLiteral] = field(repr=False)
     goal: list[ParsedLiteral] = field(repr=False)
-    conditions: Any = field(repr=False)
-    """The ``bddl.activity.Conditions`` object (for bddl's goal compilation)."""
     paper_description: str | None = None
     """The MORE paper's description with ``$scope`` words, for more-paper tasks."""
+
+    @property
+    def conditions(self) -> Any:
+        """The ``bddl.activity.Conditions`` object (for bddl's goal compilation), built on first use:
+        ``bddl.activity`` imports networkx, which showing or listing a task never needs."""
+        return _bddl_conditions(self.name)
 
     @property
     def scopes(self) -> list[str]:
@@ -110,10 +115,11 @@ def atomic_predicates(parsed: list[ParsedLiteral]) -> set[str]:
 # -- catalogue ------------------------------------------------------------------------------------
 @cache
 def task_names() -> list[str]:
-    """All 1016 activity names bddl ships, sorted."""
-    from bddl.activity import get_all_activities
+    """All 1016 activity names bddl ships (its definition folders), sorted; read without
+    ``bddl.activity``, which imports networkx."""
+    from bddl.config import ACTIVITY_CONFIGS_PATH
 
-    return sorted(get_all_activities())
+    return sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir())
 
 
 @cache
@@ -128,17 +134,24 @@ def load_task(name: str) -> TaskDefinition:
     """Parse an activity (cached per process); unknown names raise a UserError naming the closest."""
     if name not in set(task_names()):
         raise unknown_name_error("task", name, task_names())
-    from bddl.activity import Conditions
+    from bddl.parsing import parse_domain, parse_problem
 
-    conds = Conditions(name, 0, "omnigibson")
+    domain_name, *_ = parse_domain("omnigibson")
+    _, objects, init, goal = parse_problem(name, 0, domain_name)
     return TaskDefinition(
         name=name,
-        objects={syn: list(scopes) for syn, scopes in conds.parsed_objects.items()},
-        init=conds.parsed_initial_conditions,
-        goal=conds.parsed_goal_conditions,
-        conditions=conds,
+        objects={syn: list(scopes) for syn, scopes in objects.items()},
+        init=init,
+        goal=goal,
         paper_description=paper_tasks().get(name),
     )
+
+
+@cache
+def _bddl_conditions(name: str) -> Any:
+    from bddl.activity import Conditions
+
+    return Conditions(name, 0, "omnigibson")
 
 
 def is_rearrangement_goal(task: TaskDefinition) -> bool:

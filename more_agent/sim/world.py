@@ -59,6 +59,8 @@ class World:
     item moves it but counts only when something rests in or on it: a held item is never drawn."""
     _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
     """Category -> how many instance labels of it have been handed out."""
+    _by_instance: dict[int, WorldObject] = field(default_factory=dict, repr=False, init=False, compare=False)
+    """Instance id -> object, rebuilt only when an id no longer names an object of ``objects``."""
 
     # -- construction -------------------------------------------------------------------------
     @classmethod
@@ -117,6 +119,18 @@ class World:
         self.objects[obj.name] = obj
         self._changed(layout=True)
         return obj
+
+    def by_instance_ids(self, ids: Iterable[int]) -> dict[int, WorldObject]:
+        """The objects with the given instance ids (id -> object), without a pass over every object
+        on each call: sensing asks this for every frame, and a store holds hundreds of objects."""
+        found = {}
+        for i in ids:
+            obj = self._by_instance.get(i)
+            if obj is None or self.objects.get(obj.name) is not obj:  # added or removed since
+                self._by_instance = {o.instance_id: o for o in self.objects.values()}
+                obj = self._by_instance[i]
+            found[i] = obj
+        return found
 
     def semantic_id(self, category: str) -> int:
         """The semantic class id of a category (structural classes first), registering it if new."""

@@ -14,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.collections import PatchCollection  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
 
@@ -25,8 +26,9 @@ _OPEN_DOOR, _CLOSED_DOOR = "#2ca02c", "#d62728"
 _FURNITURE, _OPENABLE = "#8c6d46", "#c7822b"
 
 
-def _rect(b, **kw) -> Rectangle:
-    return Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1], **kw)
+def _rects(bounds, **kw) -> PatchCollection:
+    """Axis-aligned boxes (x0, y0, x1, y1) as one collection: a store's hundreds of boxes draw in one call."""
+    return PatchCollection([Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1]) for b in bounds], **kw)
 
 
 def draw_plan(
@@ -43,39 +45,38 @@ def draw_plan(
     leaves out are drawn in the scene's initial state.
     """
     state = open_state or {}
-    for r in scene.rooms:
-        ax.add_patch(_rect(r.bounds, facecolor=GROUND_COLOURS[r.ground], edgecolor="none", zorder=0))
-    for p in scene.ground_patches:
-        ax.add_patch(_rect(p.bounds, facecolor=GROUND_COLOURS[p.ground], edgecolor="none", zorder=1))
-    for wall in scene.walls:
-        if wall.z_min > 0:  # lintels and window tops: the gap below is drawn instead
-            continue
-        colour = _FENCE if wall.z_max < 2.0 else _WALL
-        ax.add_patch(_rect(wall.bounds, facecolor=colour, edgecolor="none", zorder=3))
-    for win in scene.windows:
-        ax.add_patch(_rect(win.bounds, facecolor=_WINDOW, edgecolor="none", zorder=4))
-    for d in scene.doors:
-        is_open = state.get(d.id, d.open)
-        ax.add_patch(_rect(d.bounds(), facecolor=_OPEN_DOOR if is_open else _CLOSED_DOOR, edgecolor="none", zorder=4))
-    for f in scene.furniture:
-        b = (
-            f.center[0] - f.size[0] / 2,
-            f.center[1] - f.size[1] / 2,
-            f.center[0] + f.size[0] / 2,
-            f.center[1] + f.size[1] / 2,
-        )
-        ax.add_patch(
-            _rect(
-                b,
-                facecolor=_OPENABLE if f.openable else _FURNITURE,
+    layers: list[tuple[float, tuple[float, float, float, float], str]] = []  # (zorder, bounds, colour)
+    layers += [(0, r.bounds, GROUND_COLOURS[r.ground]) for r in scene.rooms]
+    layers += [(1, p.bounds, GROUND_COLOURS[p.ground]) for p in scene.ground_patches]
+    # lintels and window tops (z_min > 0) are left out: the gap below is drawn instead
+    layers += [(3, w.bounds, _FENCE if w.z_max < 2.0 else _WALL) for w in scene.walls if w.z_min <= 0]
+    layers += [(4, w.bounds, _WINDOW) for w in scene.windows]
+    layers += [(4, d.bounds(), _OPEN_DOOR if state.get(d.id, d.open) else _CLOSED_DOOR) for d in scene.doors]
+    for z in sorted({z for z, _, _ in layers}):
+        rects = [(b, c) for zz, b, c in layers if zz == z]
+        ax.add_collection(_rects([b for b, _ in rects], facecolor=[c for _, c in rects], edgecolor="none", zorder=z))
+    furniture = sorted(scene.furniture, key=lambda f: f.center[2])  # higher pieces drawn over lower ones
+    if furniture:
+        ax.add_collection(
+            _rects(
+                [
+                    (
+                        f.center[0] - f.size[0] / 2,
+                        f.center[1] - f.size[1] / 2,
+                        f.center[0] + f.size[0] / 2,
+                        f.center[1] + f.size[1] / 2,
+                    )
+                    for f in furniture
+                ],
+                facecolor=[_OPENABLE if f.openable else _FURNITURE for f in furniture],
                 edgecolor="black",
                 linewidth=0.3,
                 alpha=0.85,
-                zorder=2 + f.center[2] / 10,
+                zorder=2,
             )
         )
-        if label_furniture:
-            ax.text(f.center[0], f.center[1], f.id, fontsize=4, ha="center", va="center", zorder=6)
+    for f in scene.furniture if label_furniture else ():
+        ax.text(f.center[0], f.center[1], f.id, fontsize=4, ha="center", va="center", zorder=6)
     for r in scene.rooms:
         cx, cy = (r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2
         ax.text(

@@ -109,6 +109,20 @@ def test_semantic_and_instance_of_a_known_object():
     assert table[fridge.instance_id] == {"name": "fridge_0", "label": "fridge A", "category": "fridge", "open": False, "held": False}
 
 
+def test_instance_ids_name_the_objects_after_objects_come_and_go():
+    """``World.by_instance_ids`` (read every frame by ``instance_table``) keeps no stale entry when an
+    object is removed and another added under its id."""
+    world = two_rooms()
+    fridge = world.get("fridge_0")
+    assert world.by_instance_ids([fridge.instance_id]) == {fridge.instance_id: fridge}
+    last = max(world.objects.values(), key=lambda o: o.instance_id)
+    del world.objects[last.name]
+    new = world.add(WorldObject(name="mug_9", category="mug", kind="item", room=last.room, center=np.zeros(3),
+                                size=np.full(3, 0.1)))
+    assert new.instance_id == last.instance_id
+    assert world.by_instance_ids([new.instance_id, fridge.instance_id]) == {new.instance_id: new, fridge.instance_id: fridge}
+
+
 def test_fridge_content_hidden_until_opened():
     world = two_rooms()
     world.set_robot_pose(1.0, 1.0, math.pi / 2)

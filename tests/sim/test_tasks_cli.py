@@ -21,10 +21,19 @@ def test_list_unknown_set_exits_2() -> None:
     assert "Traceback" not in result.output
 
 
-def test_show_task() -> None:
+def test_show_task_as_defined_without_placing_it() -> None:
     result = runner.invoke(app, ["tasks", "show", "putting_shopping_away"])
     assert result.exit_code == 0, result.output
-    assert "fridge A" in result.output and "(inside ?pack__of__ground_beef.n.01_1" in result.output
+    assert "(inside ?pack__of__ground_beef.n.01_1" in result.output and "$electric_refrigerator.n.01_1" in result.output
+    assert "pack__of__ground_beef.n.01_1" in result.output and "inside sack.n.01_1" in result.output
+    assert "instantiated in" not in result.output and "--seed N or --scene S" in result.output
+
+
+def test_show_task_with_a_seed_places_it_in_a_scene() -> None:
+    result = runner.invoke(app, ["tasks", "show", "putting_shopping_away", "--seed", "0"])
+    assert result.exit_code == 0, result.output
+    assert "instantiated in" in result.output and "fridge A" in result.output
+    assert "(inside ?pack__of__ground_beef.n.01_1" in result.output
 
 
 def test_show_unknown_task_exits_2_with_closest_names() -> None:
