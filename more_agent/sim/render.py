@@ -26,7 +26,6 @@ from __future__ import annotations
 import zlib
 from colorsys import hsv_to_rgb
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numba import njit
@@ -386,36 +385,3 @@ class Renderer:
 def render(world: World, camera: Camera | None = None) -> Frame:
     """One frame from the robot's pose (builds the geometry afresh; keep a ``Renderer`` to reuse it)."""
     return Renderer(camera).render(world)
-
-
-def instance_table(world: World, instance: np.ndarray) -> dict[int, dict[str, Any]]:
-    """Metadata of every instance id seen in an instance image, plus the held item.
-
-    Objects seen for the first time get their instance label here (``World.observe``), in the order
-    of their first pixel, so labels follow the order of observation.
-
-    Maps id -> {"name", "label", "category", "open" (bool, None when not openable), "held"}; the
-    held item is listed (held=True) although no camera sees it, so that a map can drop it from its
-    old place. Perception is ground truth in the paper (S.2), so this is read from the world.
-    """
-    flat = instance.ravel()
-    seen = set(np.flatnonzero(np.bincount(flat)).tolist()) - {0}
-    by_id: dict[int, WorldObject] = {o.instance_id: o for o in world.objects.values()}
-    held = world.robot.held
-    if held is not None:
-        seen.add(world.objects[held].instance_id)
-    new = [i for i in seen if not by_id[i].label and by_id[i].kind != "floor"]
-    if new:  # first observations get their labels in reading order of the image
-        ids, first = np.unique(flat, return_index=True)
-        order = {int(i): int(k) for i, k in zip(ids, first)}
-        world.observe(by_id[i].name for i in sorted(new, key=lambda i: (order.get(i, -1), i)))
-    return {
-        i: {
-            "name": by_id[i].name,
-            "label": by_id[i].label,
-            "category": by_id[i].category,
-            "open": bool(by_id[i].is_open) if by_id[i].openable else None,
-            "held": by_id[i].name == held,
-        }
-        for i in sorted(seen)
-    }

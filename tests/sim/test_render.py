@@ -9,7 +9,8 @@ import pytest
 
 from more_agent.robot_spec import OMNIGIBSON_FETCH_HFOV_DEG
 from more_agent.sim.camera import Camera, camera_pose, project
-from more_agent.sim.render import Renderer, instance_table, render, scene_geometry
+from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.render import Renderer, render, scene_geometry
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall, Window
 from more_agent.sim.world import World, WorldObject
 
@@ -44,7 +45,6 @@ def two_rooms() -> World:
     world.place("apple_0", "fridge_0", "inside")
     world.add(WorldObject(name="mug_0", category="mug", kind="item", center=np.zeros(3), size=np.array([0.1, 0.1, 0.12])))
     world.place("mug_0", "table_0", "ontop")
-    world.assign_labels()
     return world
 
 
@@ -104,7 +104,7 @@ def test_semantic_and_instance_of_a_known_object():
     assert frame.semantic[v, u] == world.class_names.index("fridge")
     assert frame.instance[v, u] == fridge.instance_id
     assert back_project(frame, v, u)[1] == pytest.approx(3.15, abs=1e-3)
-    table = instance_table(world, frame.instance)
+    table = InstanceLabels().table(world, frame.instance)
     assert table[fridge.instance_id] == {"name": "fridge_0", "label": "fridge A", "category": "fridge", "open": False, "held": False}
 
 
@@ -117,7 +117,7 @@ def test_fridge_content_hidden_until_opened():
     world.set_open("fridge_0", True)
     frame = renderer.render(world)
     assert apple in frame.instance
-    assert instance_table(world, frame.instance)[world.get("fridge_0").instance_id]["open"] is True
+    assert InstanceLabels().table(world, frame.instance)[world.get("fridge_0").instance_id]["open"] is True
 
 
 def test_open_container_keeps_its_full_box():
@@ -158,7 +158,7 @@ def test_items_rest_at_their_heights_and_held_items_vanish():
     world.pick("mug_0")
     after = render(world)
     assert mug.instance_id not in after.instance
-    assert instance_table(world, after.instance)[mug.instance_id]["held"] is True
+    assert InstanceLabels().table(world, after.instance)[mug.instance_id]["held"] is True
 
 
 def test_window_is_see_through_and_range_is_five_metres():
