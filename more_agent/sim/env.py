@@ -116,6 +116,32 @@ def frame_from_observation(obs: Mapping[str, np.ndarray]) -> Frame:
     )
 
 
+def _observation_space(cam: Camera, sensors: bool) -> spaces.Dict:
+    """The observation space (module docstring): the robot's state, and the camera's images with sensors."""
+    hw = (cam.height, cam.width)
+    ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
+    state: dict[str, spaces.Space[Any]] = {
+        "robot_pose": spaces.Box(
+            np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
+            np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]),
+            (3,),
+            np.float64,
+        ),
+        "held": spaces.Box(0, _INT32_MAX, (), np.int32),
+    }
+    if not sensors:
+        return spaces.Dict(state)
+    images: dict[str, spaces.Space[Any]] = {
+        "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
+        "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
+        "semantic": ids,
+        "instance": ids,
+        "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
+        "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
+    }
+    return spaces.Dict({**images, **state})
+
+
 class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
     """Rearrangement in the embedded BEHAVIOR-1K world with ground-truth RGB-D-semantic perception."""
 
@@ -144,31 +170,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         self.path_frame_spacing_m = path_frame_spacing_m
         self.sensors, self.privileged_info = sensors, privileged_info
         self.renderer = Renderer(camera)
-        cam = self.renderer.camera
-        hw = (cam.height, cam.width)
-        ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
-        state: dict[str, spaces.Space[Any]] = {
-            "robot_pose": spaces.Box(
-                np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
-                np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]),
-                (3,),
-                np.float64,
-            ),
-            "held": spaces.Box(0, _INT32_MAX, (), np.int32),
-        }
-        self.observation_space = spaces.Dict(
-            state
-            if not sensors
-            else {  # type: ignore[assignment]  # a Dict space
-                "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
-                "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
-                "semantic": ids,
-                "instance": ids,
-                "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
-                "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
-                **state,
-            }
-        )
+        self.observation_space = _observation_space(self.renderer.camera, sensors)  # type: ignore[assignment]  # a Dict space
         self.action_space = spaces.Dict(
             {
                 "type": spaces.Discrete(len(ACTION_TYPES)),
