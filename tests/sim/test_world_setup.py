@@ -178,7 +178,7 @@ def test_labels_follow_observation_and_reveal_no_unseen_instance() -> None:
     assert all(labels.label(o.name) == "" and labels.display(o) == o.category for o in unseen)
 
 
-def test_assign_labels_names_the_rest_after_the_reserved() -> None:
+def test_assign_all_labels_the_rest_after_the_reserved() -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2)
     inst.labels.assign_all(inst.world)
     assert inst.labels.label("fridge_0") == "fridge A"
