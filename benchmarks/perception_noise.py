@@ -29,7 +29,6 @@ from more_agent.eval.store import RunConfig, perception_part
 from more_agent.perception_spec import DEFAULTS, ERROR_KINDS, PerceptionSpec
 from more_agent.records import EpisodeRecord
 from more_agent.sim.tasks import task_set
-from more_agent.sim.world import World
 
 TASKS = task_set("more-paper")[::2][:20]
 """Every second task of the paper's set, in its order: 20 tasks across its scenes."""
@@ -119,18 +118,20 @@ def step_time(task: str, steps: int) -> dict[str, object]:
     from more_agent.planners.policies import Embodiment
     from more_agent.robot import Robot
     from more_agent.sim.env import SimRobot
-    from more_agent.sim.instantiate import instantiate
+    from more_agent.sim.instantiate import TaskInstance, instantiate
     from more_agent.sim.navgrid import free_cells, nav_grid
     from more_agent.sim.paths import shortest_path
 
-    def robot(world: World, noisy: bool) -> Robot:
-        return NoisyRobot(SimRobot(world), NoisyPerception(PerceptionSpec(mode="noisy"), world, 0)) if noisy else SimRobot(world)
+    def robot(inst: TaskInstance, noisy: bool) -> Robot:
+        sim = SimRobot(inst.world, labels=inst.labels)
+        return NoisyRobot(sim, NoisyPerception(PerceptionSpec(mode="noisy"), inst.world, inst.labels, 0)) if noisy else sim
 
     bodies, spent, frames = {}, {"gt": 0.0, "noisy": 0.0}, {"gt": 0, "noisy": 0}
     for mode in spent:
-        Embodiment(robot(instantiate(task, None, 1).world, mode == "noisy")).look_around()  # warm-up, untimed
-        world = instantiate(task, None, 0).world
-        body = bodies[mode] = Embodiment(robot(world, mode == "noisy"))
+        Embodiment(robot(instantiate(task, None, 1), mode == "noisy")).look_around()  # warm-up, untimed
+        inst = instantiate(task, None, 0)
+        world = inst.world
+        body = bodies[mode] = Embodiment(robot(inst, mode == "noisy"))
 
         def timed(sense=body.sense, mode=mode, **kw: object) -> None:
             t = time.process_time()

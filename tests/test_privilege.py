@@ -156,7 +156,7 @@ def test_no_planner_but_the_oracle_holds_ground_truth(name: str, tmp_path: Path)
 def test_the_robot_gives_nothing_of_the_world() -> None:
     """The boundary itself: what the Robot protocol hands out, and the robot's public attributes."""
     kitchen = _kitchen()
-    robot = SimRobot(kitchen.world)
+    robot = SimRobot(kitchen.world, labels=kitchen.labels)
     surface = [getattr(robot, name) for name in ("class_names", "pose", "held", "trajectory", "low_level_steps")]
     surface += [robot.sense(), robot.act("navigate_to", "fridge_0"), robot.reach_distance("fridge A")]
     surface += [value for name, value in vars(robot).items() if not name.startswith("_")]

@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import GoalChecker, GoalStatus, PrivilegedContext
     from more_agent.sim.instantiate import TaskInstance
+    from more_agent.sim.labels import InstanceLabels
     from more_agent.sim.world import World
 
 LLM_ERROR_PREFIX = "LLM error"
@@ -124,6 +125,7 @@ def run_episode(
         )
     )
     world: World | None = None
+    labels: InstanceLabels | None = None
     goals: GoalChecker | None = None
     robot: SimRobot | None = None
     perception: NoisyPerception | None = None
@@ -145,12 +147,12 @@ def run_episode(
         planner = planner or make_planner(spec.planner, spec.llm)
         record.llm = planner.llm
         record.room_llm = getattr(planner, "room_llm", None)  # only the planners that label rooms have one
-        world = instance.world
+        world, labels = instance.world, instance.labels
         record.scene, record.description = instance.scene, instance.description
         record.world_stats = world_stats(instance)
         record.trajectory = [(round(world.robot.x, 4), round(world.robot.y, 4))]
         t = clock.add("instantiate", t)
-        perception = perception_for(spec.perception, world, spec.seed, spec.task)
+        perception = perception_for(spec.perception, world, labels, spec.seed, spec.task)
         on_frame = folder.frame_writer(world.class_names) if folder is not None else None
         robot, privileged = reset_planner(
             planner,
@@ -158,14 +160,14 @@ def run_episode(
             goals,
             descriptions=spec.descriptions,
             history=spec.history,
-            on_frame=bag.hook(world, then=on_frame) if bag is not None else on_frame,
+            on_frame=bag.hook(world, instance.labels, then=on_frame) if bag is not None else on_frame,
             trace_graphs=folder is not None and folder.graphs,
             perception=perception,
         )
         clock.add("sense", t)
         if folder is not None:
             folder.start(steps_log=planner.llm is not None)
-        _run_steps(record, planner, robot, goals, world, clock, folder)
+        _run_steps(record, planner, robot, goals, world, labels, clock, folder)
     except LLMError as e:
         record.error, record.error_kind = f"{LLM_ERROR_PREFIX} ({type(e).__name__}): {e}", "llm"
         record.retryable = e.retryable
@@ -184,10 +186,10 @@ def run_episode(
         if perception is not None:
             record.misperceived = perception.misperceived(sorted(set(scope.values())))
             record.perception_aliases = dict(perception.aliases)
-    record.failure = classify_failure(record, world)
+    record.failure = classify_failure(record, world, labels)
     if folder is not None:
         t = time.perf_counter()
-        folder.write_map(record, world, set(scope.values()))
+        folder.write_map(record, world, labels, set(scope.values()))
         clock.add("write", t)
     record.timings = clock.total()
     if record.llm_usage.calls:
@@ -217,7 +219,7 @@ def reset_planner(
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import PrivilegedContext
 
-    robot = SimRobot(instance.world, on_frame=on_frame)
+    robot = SimRobot(instance.world, labels=instance.labels, on_frame=on_frame)
     grant = getattr(planner, "grant", None)
     privileged = PrivilegedContext(world=instance.world, goals=goals) if grant is not None else None
     if grant is not None:
@@ -270,7 +272,7 @@ def redraw_map(spec: EpisodeSpec, record: EpisodeRecord, out_dir: Path) -> None:
     instance = instantiate(
         spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors, descriptions=spec.descriptions
     )
-    EpisodeFolder(out_dir).write_map(record, instance.world, set(instance.scope.values()))
+    EpisodeFolder(out_dir).write_map(record, instance.world, instance.labels, set(instance.scope.values()))
 
 
 def _run_steps(
@@ -279,6 +281,7 @@ def _run_steps(
     robot: SimRobot,
     goals: GoalChecker,
     world: World,
+    labels: InstanceLabels,
     clock: _Clock,
     folder: EpisodeFolder | None = None,
 ) -> None:
@@ -312,7 +315,7 @@ def _run_steps(
         record.low_level_steps += result.low_level_steps
         _extend_path(record.trajectory, result.path)
         if folder is not None:
-            targets = [world.display_label(a) if a in world.objects else a for a in action.arguments]
+            targets = [labels.display(world.objects[a]) if a in world.objects else a for a in action.arguments]
             folder.write_step(record, status, targets, planner.step_trace())
         if action.is_done:
             record.done_called, record.termination = True, "done"

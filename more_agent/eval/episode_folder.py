@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from more_agent.planners.base import StepTrace
     from more_agent.scene_graph import SceneGraph
     from more_agent.sim.goals import GoalStatus
+    from more_agent.sim.labels import InstanceLabels
     from more_agent.sim.render import Frame
     from more_agent.sim.world import World
 
@@ -211,16 +212,22 @@ class EpisodeFolder:
         if self.graph_pictures:
             write_atomic(self.graph_path(step, ".png"), scene_graph_png(graph, title=f"step {step}"), durable=False)
 
-    def write_map(self, record: EpisodeRecord, world: World | None, labelled: Collection[str]) -> None:
+    def write_map(
+        self, record: EpisodeRecord, world: World | None, labels: InstanceLabels | None, labelled: Collection[str]
+    ) -> None:
         """The map picture (when the world was built); a picture that fails is logged, never costs the record."""
         self.path.mkdir(parents=True, exist_ok=True)
-        if world is None:
+        if world is None or labels is None:
             return
         from more_agent.viz.trajectory import trajectory_map_png
 
         try:
             png = trajectory_map_png(
-                world, record.trajectory, title=f"{record.task} ({record.scene}, {record.planner})", labelled=labelled
+                world,
+                labels,
+                record.trajectory,
+                title=f"{record.task} ({record.scene}, {record.planner})",
+                labelled=labelled,
             )
             write_atomic(self.map_path, png)
         except Exception as e:  # noqa: BLE001 - a failed picture must not lose the record or change its outcome

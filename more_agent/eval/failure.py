@@ -15,6 +15,7 @@ from collections.abc import Iterable, Sequence
 
 from more_agent.eval.termination import describe
 from more_agent.records import REACH_FAILURES, ActionRecord, EpisodeRecord, Failure, FailureCause, FailureReason
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.world import World
 from more_agent.skills import SKILLS
 
@@ -46,36 +47,36 @@ def is_reach_failure(action: ActionRecord) -> bool:
     return not action.ok and action.reason in REACH_FAILURES
 
 
-def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | None:
+def classify_failure(record: EpisodeRecord, world: World | None, labels: InstanceLabels | None) -> Failure | None:
     """The failure of a finished episode (None for a success); see the module docstring."""
     if record.success:
         return None
     if record.error_kind == "llm":
         return Failure(cause="llm_error", detail=record.error or "")
-    if record.error is not None or world is None:
+    if record.error is not None or world is None or labels is None:
         return Failure(cause="other", detail=record.error or "the episode did not run")
     ended = describe(record.termination) if record.termination not in (None, "done") else ""
     if record.all_goals_met:
         return Failure(cause="done_not_called", detail=ended or "every goal condition held; done() never called")
     unmet = [c for c in record.goal_conditions if not c.satisfied]
     needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
-    labels = {o: world.get(o).label or o for o in needed}
+    called = {o: labels.label(o) or o for o in needed}
     goal_objects = {o for c in record.goal_conditions for o in c.objects}
-    wrong = _wrong_instances(record.actions, needed, goal_objects, world)
+    wrong = _wrong_instances(record.actions, needed, goal_objects, world, labels)
     if wrong:
         return Failure(cause="wrong_instance", detail=wrong)
-    misperceived = _misperceived(record, needed, world)
+    misperceived = _misperceived(record, needed, world, labels)
     if misperceived:
         return Failure(cause="misperceived", detail=misperceived)
     unseen = [o for o in needed if o not in set(record.observed_objects)]
     if unseen:
-        return Failure(cause="never_observed", detail="never observed " + ", ".join(labels[o] for o in unseen))
+        return Failure(cause="never_observed", detail="never observed " + ", ".join(called[o] for o in unseen))
     invalid = sum(a.reason is FailureReason.INVALID_ANSWER for a in record.actions)
     if record.actions and invalid / len(record.actions) >= INVALID_SHARE:
         return Failure(
             cause="invalid_llm_answers", detail=f"{invalid} of {len(record.actions)} actions were invalid answers"
         )
-    refs = {ref for o in needed for ref in (o, labels[o])}  # the oracle names world objects, the others labels
+    refs = {ref for o in needed for ref in (o, called[o])}  # the oracle names world objects, the others labels
     on_needed = [a for a in record.actions if not a.ok and refs & set(a.arguments)]
     reach = [a for a in on_needed if is_reach_failure(a)]
     if reach:
@@ -92,38 +93,39 @@ def classify_failure(record: EpisodeRecord, world: World | None) -> Failure | No
 
 
 def _wrong_instances(
-    actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World
+    actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World, labels: InstanceLabels
 ) -> str:
     """'acted on cup B; the goal needs cup A'-style detail when the robot manipulated another instance of a
     needed object's category, one the goal does not name at all, but never the needed one; '' otherwise."""
-    goal_refs = goal_objects | {world.get(o).label for o in goal_objects if o in world.objects}
+    goal_refs = goal_objects | {labels.label(o) for o in goal_objects if o in world.objects}
     touched = {a.arguments[-1] for a in actions if a.ok and a.name in MANIPULATING and a.arguments}
     for name in needed:
         obj = world.get(name)
-        if obj.label in touched or name in touched:
+        if labels.label(name) in touched or name in touched:
             continue
         others = sorted(
             t
             for t in touched - goal_refs
-            if (o := world.objects.get(t) or world.by_label(t)) is not None and o.category == obj.category
+            if (o := world.objects.get(t) or world.objects.get(labels.find(t) or "")) is not None
+            and o.category == obj.category
         )
         if others:
-            return f"acted on {', '.join(others)}; the goal needs {obj.label or name + ' (never observed)'}"
+            return f"acted on {', '.join(others)}; the goal needs {labels.label(name) or name + ' (never observed)'}"
     return ""
 
 
-def _misperceived(record: EpisodeRecord, needed: Sequence[str], world: World) -> str:
+def _misperceived(record: EpisodeRecord, needed: Sequence[str], world: World, labels: InstanceLabels) -> str:
     """'apple A: seen as pear C'-style detail when noisy perception hid a needed object that was in view
     (never perceived as itself), or the robot manipulated an object under a label of another category;
     '' otherwise (always under ground-truth perception)."""
-    hidden = [f"{world.get(o).label or o}: {record.misperceived[o]}" for o in needed if o in record.misperceived]
+    hidden = [f"{labels.label(o) or o}: {record.misperceived[o]}" for o in needed if o in record.misperceived]
     if hidden:
         return "; ".join(hidden)
     for a in record.actions:
         label = a.arguments[-1] if a.ok and a.name in MANIPULATING and a.arguments else ""
         real = record.perception_aliases.get(label)
         if real in world.objects and not label.startswith(world.get(real).category + " "):
-            return f"acted on {label}, which is {world.get(real).label or real}"
+            return f"acted on {label}, which is {labels.label(real) or real}"
     return ""
 
 

@@ -34,7 +34,8 @@ from more_agent.interop.bag_contract import (
 )
 from more_agent.interop.requirement import require
 from more_agent.interop.transforms import matrix_pose, pose_matrix
-from more_agent.sim.render import Frame, instance_table
+from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.render import Frame
 from more_agent.sim.world import World
 
 FRAME_PERIOD_S = 0.1
@@ -85,8 +86,9 @@ class BagRecorder:
     def __exit__(self, *exc: object) -> None:
         self._writer.close()
 
-    def record(self, world: World, frame: Frame) -> None:
-        """Write one frame rendered from ``world``'s current robot pose (before the robot's mapping fuses it)."""
+    def record(self, world: World, labels: InstanceLabels, frame: Frame) -> None:
+        """Write one frame rendered from ``world``'s current robot pose (before the robot's mapping fuses it),
+        its instances named by ``labels`` (the robot's)."""
         t = self.topics
         t_ns = round(self.frames * FRAME_PERIOD_S * 1e9)
         header = self._header(t_ns, CAMERA_FRAME)
@@ -96,7 +98,7 @@ class BagRecorder:
         if self.frames == 0:
             T_base_cam = np.linalg.inv(T_world_base) @ frame.T_world_cam
             self._write(TF_STATIC_TOPIC, t_ns, self._tf(t_ns, t.base_frame, CAMERA_FRAME, T_base_cam))
-        self._write(t.labels, t_ns, self._msg(STRING, data=self._label_table(world, frame).model_dump_json()))
+        self._write(t.labels, t_ns, self._msg(STRING, data=self._label_table(world, labels, frame).model_dump_json()))
         self._write(TF_TOPIC, t_ns, self._tf(t_ns, t.world_frame, t.base_frame, T_world_base))
         position, q = matrix_pose(frame.T_world_cam)
         types = self._store.types
@@ -121,25 +123,31 @@ class BagRecorder:
             self._write(topic, t_ns, self._msg(IMAGE, header=header, **image_fields(pixels, encoding)))
         self.frames += 1
 
-    def hook(self, world: World, *, then: Callable[[Frame], None] | None = None) -> Callable[[Frame], None]:
-        """An ``on_frame`` hook recording each frame of ``world``, then calling ``then`` (another hook)."""
+    def hook(
+        self, world: World, labels: InstanceLabels, *, then: Callable[[Frame], None] | None = None
+    ) -> Callable[[Frame], None]:
+        """An ``on_frame`` hook recording each frame of ``world`` with ``labels``, then calling ``then`` (another hook)."""
 
         def on_frame(frame: Frame) -> None:
-            self.record(world, frame)
+            self.record(world, labels, frame)
             if then is not None:
                 then(frame)
 
         return on_frame
 
     # -- the label table ----------------------------------------------------------------------------
-    def _label_table(self, world: World, frame: Frame) -> LabelTable:
+    def _label_table(self, world: World, labels: InstanceLabels, frame: Frame) -> LabelTable:
         """Instances in view, the held one, those whose open state changed out of view (the robot just
         opened / closed them) and the item just put down, with its box."""
         entries = {
             iid: InstanceLabel(
-                category=d["category"], label=d["label"], open=d["open"], held=d["held"], rests=_rests(world, d["name"])
+                category=d["category"],
+                label=d["label"],
+                open=d["open"],
+                held=d["held"],
+                rests=_rests(world, labels, d["name"]),
             )
-            for iid, d in instance_table(world, frame.instance).items()
+            for iid, d in labels.table(world, frame.instance).items()
         }
         by_id = {o.instance_id: o for o in world.objects.values()}
         changed = [
@@ -160,10 +168,10 @@ class BagRecorder:
                 iid,
                 InstanceLabel(
                     category=obj.category,
-                    label=obj.label,
+                    label=labels.label(obj.name),
                     open=obj.is_open if obj.openable else None,
                     held=world.robot.held == obj.name,
-                    rests=_rests(world, obj.name),
+                    rests=_rests(world, labels, obj.name),
                 ),
             )
         self._held = world.robot.held
@@ -218,10 +226,10 @@ class BagRecorder:
         )
 
 
-def _rests(world: World, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
+def _rests(world: World, labels: InstanceLabels, name: str) -> tuple[Literal["inside", "ontop"], str | None] | None:
     """How the object rests as the robot perceives it: its support link (None for a floor), None while held."""
     obj = world.get(name)
     if obj.parent is None or obj.relation is None:
         return None if world.robot.held == name else ("ontop", None)
     parent = world.get(obj.parent)
-    return (obj.relation, None if parent.kind == "floor" else parent.label)
+    return (obj.relation, None if parent.kind == "floor" else labels.label(parent.name))

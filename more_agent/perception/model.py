@@ -3,9 +3,10 @@
 :class:`NoisyPerception` turns each ground-truth observation into the one a detector with the spec's
 errors reports (:mod:`more_agent.perception.noise`), keeps the odometry drift, and names what it sees:
 an instance seen as another category or as a second piece gets a fresh label of the category it is
-seen as (``World.fresh_label``), and :meth:`NoisyPerception.real_label` maps such a label back to the
+seen as (``InstanceLabels.fresh_label``), and :meth:`NoisyPerception.real_label` maps such a label back to the
 real object's, so a magic action on it acts on the real object. It reads the simulator's world for
-what a detector's errors depend on (sizes, kinds, categories, names) and never changes its state. Its
+what a detector's errors depend on (sizes, kinds, categories, names) and never changes its state;
+it names objects through the task instance's labels (``instance.labels``). Its
 random generator is seeded by (episode seed, task), so an episode replays the same errors.
 :class:`~more_agent.perception.robot.NoisyRobot` puts it between the simulator's robot and a planner.
 """
@@ -28,14 +29,15 @@ from more_agent.perception.noise import (
 from more_agent.perception.taxonomy import sibling_category
 from more_agent.perception_spec import PerceptionSpec, parse_perception
 from more_agent.robot import Frame, InstanceInfo
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.world import World
 
 
-def perception_for(text: str, world: World, seed: int, task: str) -> NoisyPerception | None:
+def perception_for(text: str, world: World, labels: InstanceLabels, seed: int, task: str) -> NoisyPerception | None:
     """The perception errors of an episode of ``task`` and ``seed`` in ``world`` for a mode's canonical text;
     None for ground truth (or a noisy mode with every kind off)."""
     spec = parse_perception(text)
-    return NoisyPerception(spec, world, episode_seed(seed, task)) if spec.noisy else None
+    return NoisyPerception(spec, world, labels, episode_seed(seed, task)) if spec.noisy else None
 
 
 def episode_seed(seed: int, task: str) -> int:
@@ -73,8 +75,8 @@ def draw_tables(world: World, spec: PerceptionSpec, rng: np.random.Generator) ->
 class NoisyPerception:
     """The perception errors of one episode (see the module docstring)."""
 
-    def __init__(self, spec: PerceptionSpec, world: World, seed: int) -> None:
-        self.spec, self.world, self.seed = spec, world, seed
+    def __init__(self, spec: PerceptionSpec, world: World, labels: InstanceLabels, seed: int) -> None:
+        self.spec, self.world, self.labels, self.seed = spec, world, labels, seed
         self.rng = np.random.default_rng(seed)
         self.tables = draw_tables(world, spec, self.rng)
         self.fragments = len(self.tables.size_m)
@@ -138,11 +140,11 @@ class NoisyPerception:
         confused = bool(self.tables.confused[i])
         seen_as = self.world.class_names[int(self.tables.seen_class[i])] if confused else category
         if perceived_id not in self._labels:
-            label = self.world.fresh_label(seen_as)
+            label = self.labels.fresh_label(seen_as)
             self._labels[perceived_id] = label
             self.aliases[label] = self._names[i]
             if confused and perceived_id < self.fragments:
-                self._seen_as[self.world.reserve_label(self._names[i])] = label
+                self._seen_as[self.labels.reserve(self.world.objects[self._names[i]])] = label
         return self._labels[perceived_id], seen_as
 
     def moved(self, xy: tuple[float, float], distance_m: float) -> None:
@@ -152,7 +154,7 @@ class NoisyPerception:
     def real_label(self, label: str) -> str:
         """The real object's label behind a label this perception made up; any other label as it is."""
         name = self.aliases.get(label.strip())
-        return label if name is None else self.world.reserve_label(name)
+        return label if name is None else self.labels.reserve(self.world.objects[name])
 
     def room_input(self, objects: Iterable[tuple[str, str]]) -> list[str]:
         """The categories the room classifier reads for (label, category) pairs: each object's, or, for the

@@ -66,6 +66,7 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, RoomText, SceneView, room_names, scene_view
 from more_agent.planners.llm_planner import filter_view, make_clients
 from more_agent.planners.policies import Embodiment, PolicyConfig, run_skill
+from more_agent.planners.session import MappingSession
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.planners.targets import Area, Unresolved
 from more_agent.planners.visual_memory import (
@@ -141,7 +142,7 @@ class StepLog:
     """The annotated images the VLM was shown, PNG bytes by kind ('view', 'object')."""
 
 
-class BumblePlanner:
+class BumblePlanner(MappingSession):
     """BUMBLE / BUMBLE + filtering: the :class:`~more_agent.planners.base.Planner` protocol over a VLM (module docstring)."""
 
     def __init__(self, config: BumbleConfig, client: LLMClient, spec: str) -> None:
@@ -429,12 +430,6 @@ class BumblePlanner:
         return ActionResult(ok=achieved, reason=None, feedback=feedback, low_level_steps=result.low_level_steps)
 
     # -- bookkeeping ----------------------------------------------------------------------------
-    def _body(self) -> Embodiment:
-        return needed(self.body, "reset()")
-
-    def _graph(self) -> SceneGraph:
-        return needed(self.graph, "observe()")
-
     def _current(self) -> Frame:
         return needed(self.current, "reset()")
 

@@ -58,6 +58,7 @@ from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
 from more_agent.planners.plan_prompts import PlanState, PromptKind, plan_request
 from more_agent.planners.policies import Embodiment, PolicyConfig, pick_target, run_skill
+from more_agent.planners.session import MappingSession
 from more_agent.planners.targets import Area, Target, Unresolved
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, FailureReason, HistoryMode, LLMUsage
 from more_agent.robot import ActionResult
@@ -131,7 +132,7 @@ def make_clients(llm: str | None, config: LLMConfig | None = None) -> LLMClients
     return LLMClients(plan=plan, room=room, spec=str(spec), room_spec=str(rooms))
 
 
-class LLMPlanner:
+class LLMPlanner(MappingSession):
     """MORE / MoMa-LLM: the :class:`~more_agent.planners.base.Planner` protocol over an LLM (module docstring)."""
 
     def __init__(self, config: LLMPlannerConfig, clients: LLMClients) -> None:
@@ -282,12 +283,6 @@ class LLMPlanner:
         return run_skill(self._body(), self._graph(), action.name, action.target)
 
     # -- bookkeeping ----------------------------------------------------------------------------
-    def _body(self) -> Embodiment:
-        return needed(self.body, "reset()")
-
-    def _graph(self) -> SceneGraph:
-        return needed(self.graph, "observe()")
-
     def _view(self) -> SceneView:
         return needed(self.view, "observe()")
 

@@ -22,19 +22,15 @@ from skimage.segmentation import find_boundaries
 MARK_RADIUS_FRACTION = 0.035
 """Disc radius as a fraction of the image's short side (9 px on a 256x256 frame)."""
 
-OUTLINE_COLORS: tuple[tuple[int, int, int], ...] = (
-    (230, 25, 75),
-    (60, 180, 75),
-    (255, 225, 25),
-    (0, 130, 200),
-    (245, 130, 48),
-    (145, 30, 180),
-    (70, 240, 240),
-    (240, 50, 230),
-    (210, 245, 60),
-    (250, 190, 212),
-    (0, 128, 128),
-    (170, 110, 40),
+
+def _rgb(hex_code: str) -> tuple[int, int, int]:
+    """'e6194b' -> (230, 25, 75)."""
+    r, g, b = bytes.fromhex(hex_code)
+    return r, g, b
+
+
+OUTLINE_COLORS: tuple[tuple[int, int, int], ...] = tuple(
+    map(_rgb, "e6194b 3cb44b ffe119 0082c8 f58230 911eb4 46f0f0 f032e6 d2f53c fabed4 008080 aa6e28".split())
 )
 """Outline colour of mark k is ``OUTLINE_COLORS[(k - 1) % 12]`` (a qualitative palette)."""
 

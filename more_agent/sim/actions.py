@@ -6,7 +6,8 @@ the target open. Every manipulation needs the object observable (not shut inside
 container) and within ``REACH_M`` of the robot base, measured to the object's footprint (for an
 item resting in / on furniture, to that furniture's footprint). Each
 failure returns a typed ``FailureReason`` and the short feedback a planner sees ("hand is full",
-"must open fridge A first").
+"must open fridge A first"), naming objects as the robot knows them (``labels``: the label once
+observed, else the bare category; a world name such as 'apple_o17' would reveal an unseen instance).
 
 ``navigate_to`` samples base poses on a circle around the object (radius = footprint half-diagonal
 plus ``CLEARANCE_M``), falls back to a ring around its supporting furniture, keeps the free poses
@@ -25,6 +26,7 @@ import numpy as np
 from more_agent.records import FailureReason
 from more_agent.robot import ActionResult
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
 from more_agent.sim.world import World, WorldObject
 
@@ -55,12 +57,6 @@ def _fail(reason: FailureReason, feedback: str, blocking: str | None = None) -> 
     return ActionResult(ok=False, reason=reason, feedback=feedback, blocking=blocking)
 
 
-def _label(obj: WorldObject) -> str:
-    """How feedback names an object: its label, or its bare category before it has been observed
-    (a world name such as 'apple_o17' would reveal an instance the robot has not seen)."""
-    return obj.label or obj.category
-
-
 def reach_box(world: World, name: str) -> tuple[float, float, float, float]:
     """The footprint reach is measured to: the furniture an item rests in / on, else the object's own.
 
@@ -76,7 +72,7 @@ def distance_to_footprint(world: World, name: str) -> float:
     return _point_to_box((world.robot.x, world.robot.y), reach_box(world, name))
 
 
-def _check_target(world: World, name: str) -> WorldObject | ActionResult:
+def _check_target(world: World, name: str, labels: InstanceLabels) -> WorldObject | ActionResult:
     """The object, or the failure for an unknown, held-away or hidden one."""
     if name not in world.objects:
         return _fail(FailureReason.UNKNOWN_OBJECT, f"there is no {name}")
@@ -84,15 +80,16 @@ def _check_target(world: World, name: str) -> WorldObject | ActionResult:
     hider = world.enclosing_closed_container(name)
     if hider is not None:
         return _fail(
-            FailureReason.HIDDEN, f"{_label(obj)} is inside closed {_label(hider)}; must open {_label(hider)} first"
+            FailureReason.HIDDEN,
+            f"{labels.display(obj)} is inside closed {labels.display(hider)}; must open {labels.display(hider)} first",
         )
     return obj
 
 
-def _check_reach(world: World, obj: WorldObject) -> ActionResult | None:
+def _check_reach(world: World, obj: WorldObject, labels: InstanceLabels) -> ActionResult | None:
     if world.robot.held == obj.name or distance_to_footprint(world, obj.name) <= REACH_M:
         return None
-    return _fail(FailureReason.TOO_FAR, f"{_label(obj)} is too far away")
+    return _fail(FailureReason.TOO_FAR, f"{labels.display(obj)} is too far away")
 
 
 # -- navigation ---------------------------------------------------------------------------------
@@ -169,18 +166,18 @@ def approach_rounds(world: World, name: str, config: NavConfig = DEFAULT_NAV) ->
     return [r for r in rounds if r]
 
 
-def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:
+def navigate_to(world: World, name: str, labels: InstanceLabels, config: NavConfig = DEFAULT_NAV) -> ActionResult:
     """Drive to the nearest free pose within reach of ``name`` and face it.
 
     Fails with NOT_REACHABLE when no such pose can be reached, or PATH_BLOCKED_BY_DOOR naming the
     closed door on the way (``ActionResult.blocking``) when opening it would make one reachable.
     """
-    checked = _check_target(world, name)
+    checked = _check_target(world, name, labels)
     if isinstance(checked, ActionResult):
         return checked
     obj = checked
     if world.robot.held == name:
-        return _fail(FailureReason.INVALID_TARGET, f"already holding {_label(obj)}")
+        return _fail(FailureReason.INVALID_TARGET, f"already holding {labels.display(obj)}")
     grid = nav_grid(world, config)
     start = (world.robot.x, world.robot.y)
     x0, y0, x1, y1 = obj.footprint()
@@ -193,15 +190,15 @@ def navigate_to(world: World, name: str, config: NavConfig = DEFAULT_NAV) -> Act
             final_yaw = _heading(goal, center) if math.dist(goal, center) > 1e-6 else world.robot.yaw
             steps = count_low_level_steps(world.robot.yaw, path.waypoints, final_yaw)
             world.set_robot_pose(goal[0], goal[1], final_yaw)
-            return _ok(f"reached {_label(obj)}", steps=steps, path=path.waypoints)
+            return _ok(f"reached {labels.display(obj)}", steps=steps, path=path.waypoints)
     door = blocking_door(world, start, [p for poses in rounds for p in poses], config)
     if door is not None:
         return _fail(
             FailureReason.PATH_BLOCKED_BY_DOOR,
-            f"the way to {_label(obj)} is blocked by closed {_label(world.get(door))}",
+            f"the way to {labels.display(obj)} is blocked by closed {labels.display(world.get(door))}",
             blocking=door,
         )
-    return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {_label(obj)}")
+    return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {labels.display(obj)}")
 
 
 def _point_to_box(p: XY, box: tuple[float, float, float, float]) -> float:
@@ -212,69 +209,71 @@ def _point_to_box(p: XY, box: tuple[float, float, float, float]) -> float:
 # -- manipulation -------------------------------------------------------------------------------
 
 
-def _set_open(world: World, name: str, want_open: bool) -> ActionResult:
-    checked = _check_target(world, name)
+def _set_open(world: World, name: str, labels: InstanceLabels, want_open: bool) -> ActionResult:
+    checked = _check_target(world, name, labels)
     if isinstance(checked, ActionResult):
         return checked
     obj = checked
     verb = "open" if want_open else "close"
     if world.robot.held is not None:
-        return _fail(FailureReason.HAND_FULL, f"hand is full; cannot {verb} {_label(obj)}")
+        return _fail(FailureReason.HAND_FULL, f"hand is full; cannot {verb} {labels.display(obj)}")
     if not obj.openable:
-        return _fail(FailureReason.NOT_OPENABLE, f"{_label(obj)} cannot be opened or closed")
+        return _fail(FailureReason.NOT_OPENABLE, f"{labels.display(obj)} cannot be opened or closed")
     if obj.is_open == want_open:
         reason = FailureReason.ALREADY_OPEN if want_open else FailureReason.ALREADY_CLOSED
-        return _fail(reason, f"{_label(obj)} is already {'open' if want_open else 'closed'}")
-    far = _check_reach(world, obj)
+        return _fail(reason, f"{labels.display(obj)} is already {'open' if want_open else 'closed'}")
+    far = _check_reach(world, obj, labels)
     if far is not None:
         return far
     world.set_open(name, want_open)
-    return _ok(f"{'opened' if want_open else 'closed'} {_label(obj)}")
+    return _ok(f"{'opened' if want_open else 'closed'} {labels.display(obj)}")
 
 
-def open_(world: World, name: str) -> ActionResult:
+def open_(world: World, name: str, labels: InstanceLabels) -> ActionResult:
     """Open a closed openable object (container or door) within reach, with an empty hand."""
-    return _set_open(world, name, True)
+    return _set_open(world, name, labels, True)
 
 
-def close(world: World, name: str) -> ActionResult:
+def close(world: World, name: str, labels: InstanceLabels) -> ActionResult:
     """Close an open openable object within reach, with an empty hand."""
-    return _set_open(world, name, False)
+    return _set_open(world, name, labels, False)
 
 
-def grasp(world: World, name: str) -> ActionResult:
+def grasp(world: World, name: str, labels: InstanceLabels) -> ActionResult:
     """Pick up a movable, observable item within reach, with an empty hand (what rests on / in it comes along)."""
-    checked = _check_target(world, name)
+    checked = _check_target(world, name, labels)
     if isinstance(checked, ActionResult):
         return checked
     obj = checked
     if world.robot.held is not None:
-        return _fail(FailureReason.HAND_FULL, f"hand is full; holding {_label(world.get(world.robot.held))}")
+        return _fail(FailureReason.HAND_FULL, f"hand is full; holding {labels.display(world.get(world.robot.held))}")
     if not obj.movable:
-        return _fail(FailureReason.NOT_GRASPABLE, f"{_label(obj)} cannot be picked up")
-    far = _check_reach(world, obj)
+        return _fail(FailureReason.NOT_GRASPABLE, f"{labels.display(obj)} cannot be picked up")
+    far = _check_reach(world, obj, labels)
     if far is not None:
         return far
     world.pick(name)
-    return _ok(f"grasped {_label(obj)}")
+    return _ok(f"grasped {labels.display(obj)}")
 
 
-def _place(world: World, name: str, relation: str) -> ActionResult:
+def _place(world: World, name: str, labels: InstanceLabels, relation: str) -> ActionResult:
     held = world.robot.held
     if held is None:
         return _fail(FailureReason.HAND_EMPTY, "hand is empty")
-    checked = _check_target(world, name)
+    checked = _check_target(world, name, labels)
     if isinstance(checked, ActionResult):
         return checked
     target = checked
     item = world.get(held)
     if target.kind == "door" or name == held or any(d.name == name for d in world.descendants(held)):
-        return _fail(FailureReason.INVALID_TARGET, f"cannot place {_label(item)} {relation} {_label(target)}")
+        return _fail(
+            FailureReason.INVALID_TARGET, f"cannot place {labels.display(item)} {relation} {labels.display(target)}"
+        )
     if relation == "inside" and target.kind == "floor":
-        return _fail(FailureReason.INVALID_TARGET, f"cannot place {_label(item)} inside the floor")
+        return _fail(FailureReason.INVALID_TARGET, f"cannot place {labels.display(item)} inside the floor")
     if relation == "inside" and target.openable and not target.is_open:
-        return _fail(FailureReason.TARGET_CLOSED, f"must open {_label(target)} first")
-    far = _check_reach(world, target)
+        return _fail(FailureReason.TARGET_CLOSED, f"must open {labels.display(target)} first")
+    far = _check_reach(world, target, labels)
     if far is not None:
         return far
     if target.kind == "floor":
@@ -283,20 +282,20 @@ def _place(world: World, name: str, relation: str) -> ActionResult:
         world.place_on_floor_at(held, name, (min(max(ahead[0], fx0), fx1), min(max(ahead[1], fy0), fy1)))
     else:
         world.place(held, name, relation)  # type: ignore[arg-type]
-    return _ok(f"placed {_label(item)} {'inside' if relation == 'inside' else 'on'} {_label(target)}")
+    return _ok(f"placed {labels.display(item)} {'inside' if relation == 'inside' else 'on'} {labels.display(target)}")
 
 
-def place_inside(world: World, name: str) -> ActionResult:
+def place_inside(world: World, name: str, labels: InstanceLabels) -> ActionResult:
     """Put the held item inside ``name``, which must be open if it is openable."""
-    return _place(world, name, "inside")
+    return _place(world, name, labels, "inside")
 
 
-def place_ontop(world: World, name: str) -> ActionResult:
+def place_ontop(world: World, name: str, labels: InstanceLabels) -> ActionResult:
     """Put the held item on top of ``name`` (a floor: just in front of the robot)."""
-    return _place(world, name, "ontop")
+    return _place(world, name, labels, "ontop")
 
 
-MANIPULATIONS: dict[str, Callable[[World, str], ActionResult]] = {
+MANIPULATIONS: dict[str, Callable[[World, str, InstanceLabels], ActionResult]] = {
     "open": open_,
     "close": close,
     "grasp": grasp,
@@ -304,10 +303,13 @@ MANIPULATIONS: dict[str, Callable[[World, str], ActionResult]] = {
     "place_ontop": place_ontop,
 }
 """The world's binding of the skill table's manipulations (:data:`more_agent.skills.MANIPULATION_VERBS`)
-to the functions that carry them out; each takes the world and one object name."""
+to the functions that carry them out; each takes the world, one object name and the labels its
+feedback names objects by."""
 
 
-def go_to_and(world: World, verb: str, name: str, config: NavConfig = DEFAULT_NAV) -> ActionResult:
+def go_to_and(
+    world: World, verb: str, name: str, labels: InstanceLabels, config: NavConfig = DEFAULT_NAV
+) -> ActionResult:
     """The paper's ``go_to_and_<verb>`` subpolicy: navigate next to ``name`` unless within reach, then act.
 
     Preconditions that do not depend on position are checked before moving, so a doomed action
@@ -316,13 +318,13 @@ def go_to_and(world: World, verb: str, name: str, config: NavConfig = DEFAULT_NA
     if verb not in MANIPULATIONS:
         raise ValueError(f"unknown manipulation {verb!r}; known: {', '.join(MANIPULATIONS)}")
     act = MANIPULATIONS[verb]
-    trial = act(world, name)
+    trial = act(world, name, labels)
     if trial.ok or trial.reason is not FailureReason.TOO_FAR:
         return trial
-    nav = navigate_to(world, name, config)
+    nav = navigate_to(world, name, labels, config)
     if not nav.ok:
         return nav
-    result = act(world, name)
+    result = act(world, name, labels)
     return ActionResult(
         ok=result.ok,
         reason=result.reason,

@@ -22,8 +22,9 @@ unknown object is reported in ``info`` (``action_ok`` False, ``reason``, ``feedb
 episode goes on.
 
 ``reset(seed=..., options={"task": ..., "scene": ..., "instance": TaskInstance, "task_seed": int,
-"world": World})``: an injected instance is used as is; so is an injected world (no task, the
-robot where it stands); a task is instantiated (seed ``task_seed``, else drawn from
+"world": World, "labels": InstanceLabels})``: an injected instance is used as is, with its labels; so
+is an injected world (no task, the robot where it stands; its objects labelled through ``labels`` when
+given, else afresh); a task is instantiated (seed ``task_seed``, else drawn from
 ``np_random``); a scene alone (default ``DEFAULT_SCENE``) gets no task and a start pose drawn from
 ``np_random`` among the free cells of the navigation grid. With sensors every episode starts with
 a full turn in place (S.3): ``info["turn_frames"]`` holds the frames of the turn, and the observation is the
@@ -61,8 +62,9 @@ from more_agent.sim import actions, motion
 from more_agent.sim.camera import Camera, camera_pose
 from more_agent.sim.goals import GoalChecker, GoalStatus
 from more_agent.sim.instantiate import TaskInstance, instantiate
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import free_cells, nav_grid
-from more_agent.sim.render import Frame, Renderer, instance_table
+from more_agent.sim.render import Frame, Renderer
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.world import World, floor_name
 from more_agent.skills import SKILLS
@@ -114,6 +116,32 @@ def frame_from_observation(obs: Mapping[str, np.ndarray]) -> Frame:
     )
 
 
+def _observation_space(cam: Camera, sensors: bool) -> spaces.Dict:
+    """The observation space (module docstring): the robot's state, and the camera's images with sensors."""
+    hw = (cam.height, cam.width)
+    ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
+    state: dict[str, spaces.Space[Any]] = {
+        "robot_pose": spaces.Box(
+            np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
+            np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]),
+            (3,),
+            np.float64,
+        ),
+        "held": spaces.Box(0, _INT32_MAX, (), np.int32),
+    }
+    if not sensors:
+        return spaces.Dict(state)
+    images: dict[str, spaces.Space[Any]] = {
+        "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
+        "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
+        "semantic": ids,
+        "instance": ids,
+        "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
+        "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
+    }
+    return spaces.Dict({**images, **state})
+
+
 class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
     """Rearrangement in the embedded BEHAVIOR-1K world with ground-truth RGB-D-semantic perception."""
 
@@ -142,31 +170,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         self.path_frame_spacing_m = path_frame_spacing_m
         self.sensors, self.privileged_info = sensors, privileged_info
         self.renderer = Renderer(camera)
-        cam = self.renderer.camera
-        hw = (cam.height, cam.width)
-        ids = spaces.Box(0, _INT32_MAX, hw, np.int32)
-        state: dict[str, spaces.Space[Any]] = {
-            "robot_pose": spaces.Box(
-                np.array([-_COORD_LIMIT_M, -_COORD_LIMIT_M, -math.pi]),
-                np.array([_COORD_LIMIT_M, _COORD_LIMIT_M, math.pi]),
-                (3,),
-                np.float64,
-            ),
-            "held": spaces.Box(0, _INT32_MAX, (), np.int32),
-        }
-        self.observation_space = spaces.Dict(
-            state
-            if not sensors
-            else {  # type: ignore[assignment]  # a Dict space
-                "rgb": spaces.Box(0, 255, (*hw, 3), np.uint8),
-                "depth": spaces.Box(0.0, cam.max_range_m, hw, np.float32),
-                "semantic": ids,
-                "instance": ids,
-                "pose": spaces.Box(-_COORD_LIMIT_M, _COORD_LIMIT_M, (4, 4), np.float64),
-                "intrinsics": spaces.Box(0.0, _COORD_LIMIT_M, (3, 3), np.float64),
-                **state,
-            }
-        )
+        self.observation_space = _observation_space(self.renderer.camera, sensors)  # type: ignore[assignment]  # a Dict space
         self.action_space = spaces.Dict(
             {
                 "type": spaces.Discrete(len(ACTION_TYPES)),
@@ -175,6 +179,8 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             }
         )
         self.world: World | None = None
+        self.labels = InstanceLabels()
+        """What the robot calls the objects it has seen (the instance's, else the injected ones)."""
         self.instance: TaskInstance | None = None
         self._goal: GoalChecker | None = None
         self._progress = 0.0
@@ -191,13 +197,14 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         world = options.get("world")
         self.instance = self._load(options) if world is None else None
         if self.instance is not None:
-            self.world = self.instance.world
+            self.world, self.labels = self.instance.world, self.instance.labels
             self._goal = GoalChecker(self.instance)
         elif world is not None:
             self.world, self._goal = world, None
+            self.labels = options["labels"] if options.get("labels") is not None else InstanceLabels()
         else:
             self.world = World.from_scene(get_scene(options.get("scene") or self.scene or DEFAULT_SCENE, 0))
-            self._goal = None
+            self._goal, self.labels = None, InstanceLabels()
             self._spawn()
         self._steps, self._low_level_steps = 0, 0
         turn_frames = self._turn_around() if self.sensors else [self._record()]
@@ -244,9 +251,9 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             else:
                 assert kind is not None  # parsed without error
                 act = (
-                    actions.navigate_to(self.world, name)
+                    actions.navigate_to(self.world, name, self.labels)
                     if kind == "navigate_to"
-                    else actions.go_to_and(self.world, kind, name)
+                    else actions.go_to_and(self.world, kind, name, self.labels)
                 )
                 ok, reason, feedback, steps = (
                     act.ok,
@@ -273,10 +280,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
         key = target.strip()
         if key in self.world.objects:
             return key
-        obj = self.world.by_label(key) or next(
-            (o for o in self.world.objects.values() if o.label and o.label.lower() == key.lower()), None
-        )
-        return obj.name if obj is not None else None
+        return self.labels.find(key, ignore_case=True)
 
     def render(self) -> np.ndarray | None:
         """The RGB frame of the latest observation (``render_mode="rgb_array"``)."""
@@ -354,7 +358,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             "intrinsics": frame.K,
             **state,
         }
-        return {"obs": obs, "instances": instance_table(self.world, frame.instance)}
+        return {"obs": obs, "instances": self.labels.table(self.world, frame.instance)}
 
     def _path_frames(self, path: list[tuple[float, float]]) -> list[dict[str, Any]]:
         """Views every ``path_frame_spacing_m`` along a path, facing along it (none when disabled)."""
@@ -405,12 +409,20 @@ class SimRobot:
     """
 
     def __init__(
-        self, world: World, *, renderer: Renderer | None = None, on_frame: Callable[[Frame], None] | None = None
+        self,
+        world: World,
+        *,
+        labels: InstanceLabels | None = None,
+        renderer: Renderer | None = None,
+        on_frame: Callable[[Frame], None] | None = None,
     ) -> None:
-        """``on_frame`` is called with every rendered frame (the episode folder writes them)."""
+        """``labels``: what the robot calls objects (the task instance's, with those its description names
+        reserved; else afresh); ``on_frame`` is called with every rendered frame (the episode folder
+        writes them)."""
         self._world = world
+        self._labels = labels if labels is not None else InstanceLabels()
         self._env = MoreAgentEnv(sensors=False, max_steps=None)
-        self._env.reset(options={"world": world})
+        self._env.reset(options={"world": world, "labels": self._labels})
         self._renderer = renderer or Renderer()
         self._on_frame = on_frame
         self._held: str | None = None
@@ -461,7 +473,7 @@ class SimRobot:
             frame = self._renderer.render_at(world, pose)
         if self._on_frame is not None:
             self._on_frame(frame)
-        table = instance_table(world, frame.instance)
+        table = self._labels.table(world, frame.instance)
         infos = {
             i: InstanceInfo(
                 label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
@@ -475,7 +487,7 @@ class SimRobot:
             infos.setdefault(
                 obj.instance_id,
                 InstanceInfo(
-                    label=obj.label,
+                    label=self._labels.label(name),
                     category=obj.category,
                     open=obj.is_open if obj.openable else None,
                     held=world.robot.held == name,
@@ -496,7 +508,7 @@ class SimRobot:
         if obj.parent is None or obj.relation is None:
             return None if self._world.robot.held == name else ("ontop", None)
         parent = self._world.get(obj.parent)
-        return obj.relation, parent.label if parent.kind != "floor" else None
+        return obj.relation, self._labels.label(parent.name) if parent.kind != "floor" else None
 
     def move_forward(self, distance: float) -> bool:
         ok = bool(self._step("move_forward", amount=distance)["action_ok"])

@@ -150,44 +150,84 @@ def generate_floorplan(
     items = {room: _room_items(objs) for room, objs in rooms.items()}
     growth = dict.fromkeys(rooms, 1.0)
     for _ in range(max_attempts):
-        rects = _layout(rooms, items, rng, clearance_factor, growth, k)
-        runs = _wall_runs(rects)
-        doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k)
-        if doors is None:
-            growth = {r: g * 1.1 for r, g in growth.items()}
-            continue
-        windows = _place_windows(runs, doors, rng, k)
-        try:
-            furniture, patches = _furnish_all(rects, items, doors, windows, rng, k)
-        except _Retry as e:
-            growth = {r: g * (1.4 if r == e.room else 1.05) for r, g in growth.items()}  # mostly the failing room
-            continue
-        walls = _walls(runs, doors, windows, wall_height_m, k)
-        allx = [v for r in rects.values() for v in (r[0], r[2])]
-        ally = [v for r in rects.values() for v in (r[1], r[3])]
-        pad = wall_thickness_m
-        return Scene(
-            name=name,
-            seed=seed,
-            wall_height=wall_height_m,
-            bounds=_round((min(allx) - pad, min(ally) - pad, max(allx) + pad, max(ally) + pad)),
-            rooms=[
-                Room(
-                    id=rid,
-                    type=room_type(rid),
-                    bounds=rects[rid],
-                    ground="lawn" if room_type(rid) in OUTDOOR_ROOM_TYPES else "floor",
-                    outdoor=room_type(rid) in OUTDOOR_ROOM_TYPES,
-                )
-                for rid in rooms
-            ],
-            walls=walls,
-            doors=doors,
-            windows=windows,
-            furniture=furniture,
-            ground_patches=patches,
+        plan, growth = _try_layout(
+            rooms, items, growth, rng, clearance_factor, closed_door_fraction, extra_door_probability, wall_height_m, k
         )
+        if plan is not None:
+            return _scene(name, seed, rooms, plan, wall_height_m, wall_thickness_m)
     raise RuntimeError(f"could not lay out scene {name!r} in {max_attempts} attempts")
+
+
+@dataclass
+class _Plan:
+    """A laid-out, furnished floor plan: what a ``Scene`` is made of."""
+
+    rects: dict[str, Rect]
+    walls: list[Wall]
+    doors: list[Door]
+    windows: list[Window]
+    furniture: list[Furniture]
+    patches: list[GroundPatch]
+
+
+def _try_layout(
+    rooms: dict[str, dict[str, int]],
+    items: dict[str, list[_Item]],
+    growth: dict[str, float],
+    rng: np.random.Generator,
+    clearance_factor: float,
+    closed_door_fraction: float,
+    extra_door_probability: float,
+    wall_height_m: float,
+    k: dict[str, float],
+) -> tuple[_Plan | None, dict[str, float]]:
+    """One attempt: rooms laid out at ``growth`` times their size, doors, windows, furniture, walls.
+
+    Returns the plan, or None and the growth to try next: every room a little larger when the doors
+    did not fit, mostly the room whose furniture did not fit otherwise.
+    """
+    rects = _layout(rooms, items, rng, clearance_factor, growth, k)
+    runs = _wall_runs(rects)
+    doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k)
+    if doors is None:
+        return None, {r: g * 1.1 for r, g in growth.items()}
+    windows = _place_windows(runs, doors, rng, k)
+    try:
+        furniture, patches = _furnish_all(rects, items, doors, windows, rng, k)
+    except _Retry as e:
+        return None, {r: g * (1.4 if r == e.room else 1.05) for r, g in growth.items()}
+    walls = _walls(runs, doors, windows, wall_height_m, k)
+    return _Plan(rects, walls, doors, windows, furniture, patches), growth
+
+
+def _scene(
+    name: str, seed: int, rooms: dict[str, dict[str, int]], plan: _Plan, wall_height_m: float, pad: float
+) -> Scene:
+    """The ``Scene`` of a plan: its rooms in the order given, bounds ``pad`` beyond the outer walls."""
+    rects = plan.rects
+    allx = [v for r in rects.values() for v in (r[0], r[2])]
+    ally = [v for r in rects.values() for v in (r[1], r[3])]
+    return Scene(
+        name=name,
+        seed=seed,
+        wall_height=wall_height_m,
+        bounds=_round((min(allx) - pad, min(ally) - pad, max(allx) + pad, max(ally) + pad)),
+        rooms=[
+            Room(
+                id=rid,
+                type=room_type(rid),
+                bounds=rects[rid],
+                ground="lawn" if room_type(rid) in OUTDOOR_ROOM_TYPES else "floor",
+                outdoor=room_type(rid) in OUTDOOR_ROOM_TYPES,
+            )
+            for rid in rooms
+        ],
+        walls=plan.walls,
+        doors=plan.doors,
+        windows=plan.windows,
+        furniture=plan.furniture,
+        ground_patches=plan.patches,
+    )
 
 
 def scene_rng(name: str, seed: int) -> np.random.Generator:

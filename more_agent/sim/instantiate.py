@@ -22,7 +22,7 @@ Steps (all deterministic for a given task, scene and seed):
 6. The robot starts at a random reachable pose (``sim.start``), or with ``start="task-room"`` at a
    free spot of the room of its ``ontop agent floor`` literal.
 7. Only the instances the description names get their labels now; every other instance is
-   labelled when first observed (``World.observe``).
+   labelled when first observed (``TaskInstance.labels``, :mod:`more_agent.sim.labels`).
 8. Every supported init literal is evaluated through our bddl backend; a false one raises
    ``InstantiationError`` naming it. Literals that do not apply to rearrangement (cooked,
    covered, filled, ...) and literals over virtual scopes are kept in ``unsupported_literals``.
@@ -46,6 +46,7 @@ from more_agent.sim.clutter import Clutter, add_distractors, clutter_rng
 from more_agent.sim.descriptions import check_description_mode, description_template
 from more_agent.sim.fixtures import hang_listed_fixtures
 from more_agent.sim.floorspots import free_floor_spot
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.packing import support_surface
 from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
@@ -115,6 +116,8 @@ class TaskInstance:
     class_description: str = ""
     """The description naming instances by class ('the fridge'), for planners whose scene text shows
     classes, not instance labels (MoMa-LLM: :func:`class_description`)."""
+    labels: InstanceLabels = field(default_factory=InstanceLabels)
+    """What the robot calls the objects: those the description names reserved up front, the rest as observed."""
 
     def scope_objects(self) -> dict[str, ScopeObject]:
         """The filled bddl scope: every entry a ``ScopeObject``."""
@@ -127,7 +130,7 @@ class TaskInstance:
     def label(self, scope: str) -> str:
         """Readable name of a scope's object: its label ('apple A') or, before it is observed, its
         category; a floor's room or 'the robot'."""
-        return _readable(self.world, self.scope[scope])
+        return _readable(self.world, self.labels, self.scope[scope])
 
 
 def instantiate(
@@ -262,7 +265,7 @@ def class_description(instance: TaskInstance) -> str:
 def _scope_phrase(instance: TaskInstance, scope: str) -> str:
     """A scope's label; a scope the paper names but bddl 3.6 lacks reads as 'the <category>'."""
     if scope in instance.scope:
-        return _readable(instance.world, instance.scope[scope], reserve=True)
+        return _readable(instance.world, instance.labels, instance.scope[scope], reserve=True)
     return f"the {category_phrase(scope_synset(scope))}"
 
 
@@ -508,7 +511,7 @@ def _item_name(scope: str, taken: set[str]) -> str:
     return f"{lemma}_n{sense}_{index}_{k}"
 
 
-def _readable(world: World, name: str, *, reserve: bool = False) -> str:
+def _readable(world: World, labels: InstanceLabels, name: str, *, reserve: bool = False) -> str:
     """How a description names an object; with ``reserve`` an unlabelled one gets its label now."""
     if name == ROBOT_NAME:
         return "the robot"
@@ -518,7 +521,7 @@ def _readable(world: World, name: str, *, reserve: bool = False) -> str:
     if obj.kind == "floor":
         room = world.scene.room(obj.room) if obj.room else None
         return f"the {room.type.replace('_', ' ')} floor" if room else "the floor"
-    return world.reserve_label(name) if reserve else world.display_label(name)
+    return labels.reserve(obj) if reserve else labels.display(obj)
 
 
 def _verify_init(instance: TaskInstance) -> None:

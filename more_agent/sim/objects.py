@@ -20,7 +20,6 @@ class WorldObject:
     size: np.ndarray
     room: str | None = None
     synset: str | None = None
-    label: str = ""
     openable: bool = False
     is_open: bool = False
     cloth: bool = False

@@ -26,7 +26,6 @@ from __future__ import annotations
 import zlib
 from colorsys import hsv_to_rgb
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numba import njit
@@ -199,6 +198,104 @@ def _build_grid(
 
 
 @njit(cache=True, error_model="numpy")
+def _ray_direction(rot: np.ndarray, rays: np.ndarray, r: int) -> tuple[float, float, float]:
+    """World-frame direction ``rot @ rays[r]`` (camera z = 1), no component exactly zero."""
+    dx = rot[0, 0] * rays[r, 0] + rot[0, 1] * rays[r, 1] + rot[0, 2]
+    dy = rot[1, 0] * rays[r, 0] + rot[1, 1] * rays[r, 1] + rot[1, 2]
+    dz = rot[2, 0] * rays[r, 0] + rot[2, 1] * rays[r, 1] + rot[2, 2]
+    if dx == 0.0:
+        dx = 1e-12
+    if dy == 0.0:
+        dy = 1e-12
+    if dz == 0.0:
+        dz = 1e-12
+    return dx, dy, dz
+
+
+@njit(cache=True, error_model="numpy")
+def _clip(a: float, b: float, o: float, inv: float, tn: float, tf: float) -> tuple[float, float]:
+    """The ray interval [tn, tf] narrowed to the slab a <= o + t / inv <= b along one axis."""
+    ta, tb = (a - o) * inv, (b - o) * inv
+    return max(tn, min(ta, tb)), min(tf, max(ta, tb))
+
+
+@njit(cache=True, error_model="numpy")
+def _box_entry(
+    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, inv: tuple[float, float, float]
+) -> tuple[float, float, int]:
+    """Slab test of box ``b``: (entry t, exit t, axis of the face entered: 0 x, 1 y, 2 z)."""
+    ta, tb = (lo[b, 0] - o[0]) * inv[0], (hi[b, 0] - o[0]) * inv[0]
+    t0, t1, f = min(ta, tb), max(ta, tb), 0
+    ta, tb = (lo[b, 1] - o[1]) * inv[1], (hi[b, 1] - o[1]) * inv[1]
+    if min(ta, tb) > t0:
+        t0, f = min(ta, tb), 1
+    t1 = min(t1, max(ta, tb))
+    ta, tb = (lo[b, 2] - o[2]) * inv[2], (hi[b, 2] - o[2]) * inv[2]
+    if min(ta, tb) > t0:
+        t0, f = min(ta, tb), 2
+    t1 = min(t1, max(ta, tb))
+    return t0, t1, f
+
+
+@njit(cache=True, error_model="numpy")
+def _walk_grid(
+    r: int,
+    o: np.ndarray,
+    d: tuple[float, float, float],
+    inv: tuple[float, float, float],
+    tn: float,
+    tf: float,
+    x0: float,
+    y0: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    start: np.ndarray,
+    items: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    mailbox: np.ndarray,
+) -> tuple[float, int, int]:
+    """Nearest box hit by ray ``r`` within [tn, tf]: (t, box, face axis), box -1 on a miss.
+
+    Walks the grid cells the ray crosses in order (Amanatides-Woo) and stops once the nearest hit
+    lies before the next cell; each box is tested once per ray (``mailbox``).
+    """
+    cx = min(nx - 1, max(0, int((o[0] + tn * d[0] - x0) / cell)))
+    cy = min(ny - 1, max(0, int((o[1] + tn * d[1] - y0) / cell)))
+    sx = 1 if d[0] > 0 else -1
+    sy = 1 if d[1] > 0 else -1
+    tmx = (x0 + (cx + (1 if sx > 0 else 0)) * cell - o[0]) * inv[0]
+    tmy = (y0 + (cy + (1 if sy > 0 else 0)) * cell - o[1]) * inv[1]
+    tdx, tdy = cell * abs(inv[0]), cell * abs(inv[1])
+    best, best_b, best_f = np.inf, -1, -1
+    while True:
+        c = cy * nx + cx
+        for k in range(start[c], start[c + 1]):
+            b = items[k]
+            if mailbox[b] == r:
+                continue
+            mailbox[b] = r
+            t0, t1, f = _box_entry(lo, hi, b, o, inv)
+            if t0 <= t1 and t0 >= 0.0 and t0 < best:
+                best, best_b, best_f = t0, b, f
+        t_exit = min(tmx, tmy)
+        if best <= t_exit or t_exit >= tf:
+            break
+        if tmx < tmy:
+            cx += sx
+            tmx += tdx
+            if cx < 0 or cx >= nx:
+                break
+        else:
+            cy += sy
+            tmy += tdy
+            if cy < 0 or cy >= ny:
+                break
+    return best, best_b, best_f
+
+
+@njit(cache=True, error_model="numpy")
 def _cast(
     origin: np.ndarray,
     rot: np.ndarray,
@@ -223,78 +320,27 @@ def _cast(
 ) -> None:
     """Nearest hit of each ray origin + t * rot @ rays[r], t in [0, max_t]; NaN / 0 / 0 / black on a miss.
 
-    Camera-frame rays have z = 1, so t is the z-depth. Each box is tested once per ray (mailbox).
-    The colour is the class's palette entry dimmed by the face hit and by depth.
+    Camera-frame rays have z = 1, so t is the z-depth. The colour is the class's palette entry dimmed
+    by the face hit and by depth.
     """
-    n_boxes = lo.shape[0]
-    mailbox = np.full(n_boxes, -1, dtype=np.int64)
+    mailbox = np.full(lo.shape[0], -1, dtype=np.int64)
     zlo, zhi = np.inf, -np.inf
-    for b in range(n_boxes):
+    for b in range(lo.shape[0]):
         zlo, zhi = min(zlo, lo[b, 2]), max(zhi, hi[b, 2])
-    ox, oy, oz = origin[0], origin[1], origin[2]
-    gx1, gy1 = x0 + nx * cell, y0 + ny * cell
     for r in range(rays.shape[0]):
         depth[r], sem[r], inst[r] = np.nan, 0, 0
         rgb[r, 0], rgb[r, 1], rgb[r, 2] = 0, 0, 0
-        dx = rot[0, 0] * rays[r, 0] + rot[0, 1] * rays[r, 1] + rot[0, 2]
-        dy = rot[1, 0] * rays[r, 0] + rot[1, 1] * rays[r, 1] + rot[1, 2]
-        dz = rot[2, 0] * rays[r, 0] + rot[2, 1] * rays[r, 1] + rot[2, 2]
-        if dx == 0.0:
-            dx = 1e-12
-        if dy == 0.0:
-            dy = 1e-12
-        if dz == 0.0:
-            dz = 1e-12
-        ix_, iy_, iz_ = 1.0 / dx, 1.0 / dy, 1.0 / dz
+        d = _ray_direction(rot, rays, r)
+        inv = (1.0 / d[0], 1.0 / d[1], 1.0 / d[2])
         # clip the ray to the grid's xy extent, the boxes' z extent and the range
-        ta, tb = (x0 - ox) * ix_, (gx1 - ox) * ix_
-        tn, tf = max(0.0, min(ta, tb)), min(max_t, max(ta, tb))
-        ta, tb = (y0 - oy) * iy_, (gy1 - oy) * iy_
-        tn, tf = max(tn, min(ta, tb)), min(tf, max(ta, tb))
-        ta, tb = (zlo - oz) * iz_, (zhi - oz) * iz_
-        tn, tf = max(tn, min(ta, tb)), min(tf, max(ta, tb))
+        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, max_t)
+        tn, tf = _clip(y0, y0 + ny * cell, origin[1], inv[1], tn, tf)
+        tn, tf = _clip(zlo, zhi, origin[2], inv[2], tn, tf)
         if tn > tf:
             continue
-        cx = min(nx - 1, max(0, int((ox + tn * dx - x0) / cell)))
-        cy = min(ny - 1, max(0, int((oy + tn * dy - y0) / cell)))
-        sx = 1 if dx > 0 else -1
-        sy = 1 if dy > 0 else -1
-        tmx = (x0 + (cx + (1 if sx > 0 else 0)) * cell - ox) * ix_
-        tmy = (y0 + (cy + (1 if sy > 0 else 0)) * cell - oy) * iy_
-        tdx, tdy = cell * abs(ix_), cell * abs(iy_)
-        best, best_b, best_f = np.inf, -1, -1
-        while True:
-            c = cy * nx + cx
-            for k in range(start[c], start[c + 1]):
-                b = items[k]
-                if mailbox[b] == r:
-                    continue
-                mailbox[b] = r
-                ta, tb = (lo[b, 0] - ox) * ix_, (hi[b, 0] - ox) * ix_
-                t0, t1, f = min(ta, tb), max(ta, tb), 0
-                ta, tb = (lo[b, 1] - oy) * iy_, (hi[b, 1] - oy) * iy_
-                if min(ta, tb) > t0:
-                    t0, f = min(ta, tb), 1
-                t1 = min(t1, max(ta, tb))
-                ta, tb = (lo[b, 2] - oz) * iz_, (hi[b, 2] - oz) * iz_
-                if min(ta, tb) > t0:
-                    t0, f = min(ta, tb), 2
-                t1 = min(t1, max(ta, tb))
-                if t0 <= t1 and t0 >= 0.0 and t0 < best:
-                    best, best_b, best_f = t0, b, f
-            t_exit = min(tmx, tmy)
-            if best <= t_exit or t_exit >= tf:
-                break
-            if tmx < tmy:
-                cx += sx
-                tmx += tdx
-                if cx < 0 or cx >= nx:
-                    break
-            else:
-                cy += sy
-                tmy += tdy
-                if cy < 0 or cy >= ny:
-                    break
+        best, best_b, best_f = _walk_grid(
+            r, origin, d, inv, tn, tf, x0, y0, cell, nx, ny, start, items, lo, hi, mailbox
+        )
         if best_b >= 0 and best <= max_t:
             depth[r], sem[r], inst[r] = best, box_sem[best_b], box_inst[best_b]
             shade = (0.80 if best_f == 0 else 0.65 if best_f == 1 else 1.0) * (1.0 - 0.35 * best / max_t)
@@ -386,36 +432,3 @@ class Renderer:
 def render(world: World, camera: Camera | None = None) -> Frame:
     """One frame from the robot's pose (builds the geometry afresh; keep a ``Renderer`` to reuse it)."""
     return Renderer(camera).render(world)
-
-
-def instance_table(world: World, instance: np.ndarray) -> dict[int, dict[str, Any]]:
-    """Metadata of every instance id seen in an instance image, plus the held item.
-
-    Objects seen for the first time get their instance label here (``World.observe``), in the order
-    of their first pixel, so labels follow the order of observation.
-
-    Maps id -> {"name", "label", "category", "open" (bool, None when not openable), "held"}; the
-    held item is listed (held=True) although no camera sees it, so that a map can drop it from its
-    old place. Perception is ground truth in the paper (S.2), so this is read from the world.
-    """
-    flat = instance.ravel()
-    seen = set(np.flatnonzero(np.bincount(flat)).tolist()) - {0}
-    held = world.robot.held
-    if held is not None:
-        seen.add(world.objects[held].instance_id)
-    by_id = world.by_instance_ids(seen)
-    new = [i for i in seen if not by_id[i].label and by_id[i].kind != "floor"]
-    if new:  # first observations get their labels in reading order of the image
-        ids, first = np.unique(flat, return_index=True)
-        order = {int(i): int(k) for i, k in zip(ids, first)}
-        world.observe(by_id[i].name for i in sorted(new, key=lambda i: (order.get(i, -1), i)))
-    return {
-        i: {
-            "name": by_id[i].name,
-            "label": by_id[i].label,
-            "category": by_id[i].category,
-            "open": bool(by_id[i].is_open) if by_id[i].openable else None,
-            "held": by_id[i].name == held,
-        }
-        for i in sorted(seen)
-    }

@@ -5,14 +5,11 @@ is open, what is held) and geometric where sensing and navigation need it (axis-
 Positions of movable items are derived from their support: an item placed on or in a parent takes
 the first free slot on the parent's top surface or interior floor (:mod:`more_agent.sim.packing`
 says where; the world only rests it there). Nothing here knows about tasks,
-actions or rendering; they read and change the world through this API.
+actions, rendering or what the robot calls an object (:mod:`more_agent.sim.labels`); they read and change the world through this API.
 """
 
 from __future__ import annotations
 
-import re
-import string
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -57,10 +54,6 @@ class World:
     """Increases on every change of an object (pose, support, open state); unlike ``version``, not
     when the robot merely moves, so renderers rebuild their geometry only when it changed. Carrying an
     item moves it but counts only when something rests in or on it: a held item is never drawn."""
-    _labels_used: dict[str, int] = field(default_factory=dict, repr=False, init=False)
-    """Category -> how many instance labels of it have been handed out."""
-    _by_instance: dict[int, WorldObject] = field(default_factory=dict, repr=False, init=False, compare=False)
-    """Instance id -> object, rebuilt only when an id no longer names an object of ``objects``."""
 
     # -- construction -------------------------------------------------------------------------
     @classmethod
@@ -120,18 +113,6 @@ class World:
         self._changed(layout=True)
         return obj
 
-    def by_instance_ids(self, ids: Iterable[int]) -> dict[int, WorldObject]:
-        """The objects with the given instance ids (id -> object), without a pass over every object
-        on each call: sensing asks this for every frame, and a store holds hundreds of objects."""
-        found = {}
-        for i in ids:
-            obj = self._by_instance.get(i)
-            if obj is None or self.objects.get(obj.name) is not obj:  # added or removed since
-                self._by_instance = {o.instance_id: o for o in self.objects.values()}
-                obj = self._by_instance[i]
-            found[i] = obj
-        return found
-
     def semantic_id(self, category: str) -> int:
         """The semantic class id of a category (structural classes first), registering it if new."""
         try:
@@ -140,52 +121,10 @@ class World:
             self.class_names.append(category)
             return len(self.class_names) - 1
 
-    # -- instance labels ----------------------------------------------------------------------
-    # An object has no label until it is observed (or named by the task description): labels are
-    # handed out per category in that order, so a label never reveals an instance not yet seen.
-    def reserve_label(self, name: str) -> str:
-        """The object's label, giving it the next free one of its category first if it has none.
-
-        Floors get none (they are named by their room).
-        """
-        obj = self.objects[name]
-        if not obj.label and obj.kind != "floor":
-            used = self._labels_used.get(obj.category, 0)
-            obj.label = f"{obj.category} {_alpha(used)}"
-            self._labels_used[obj.category] = used + 1
-        return obj.label
-
-    def fresh_label(self, category: str) -> str:
-        """The next free label of ``category``, handed out to no object: what a noisy perception calls an
-        instance it sees as another category, or a second piece of one (``more_agent.perception``)."""
-        used = self._labels_used.get(category, 0)
-        self._labels_used[category] = used + 1
-        return f"{category} {_alpha(used)}"
-
-    def observe(self, names: Iterable[str]) -> None:
-        """Label the objects among ``names`` seen for the first time, in the order given."""
-        for name in names:
-            self.reserve_label(name)
-
-    def display_label(self, name: str) -> str:
-        """What the robot may call an object: its label once observed, else just its category."""
-        obj = self.objects[name]
-        return obj.label or obj.category
-
-    def assign_labels(self) -> None:
-        """Label every object not labelled yet, per category in name order (tools and tests; an
-        episode labels objects as they are observed)."""
-        for obj in sorted(self.objects.values(), key=lambda o: _natural_key(o.name)):
-            self.reserve_label(obj.name)
-
     # -- queries ------------------------------------------------------------------------------
     def get(self, name: str) -> WorldObject:
         """The object with this name (KeyError if none)."""
         return self.objects[name]
-
-    def by_label(self, label: str) -> WorldObject | None:
-        """The object with this alphabetical label, if any."""
-        return next((o for o in self.objects.values() if o.label == label), None)
 
     def children(self, name: str, relation: Relation | None = None) -> list[WorldObject]:
         """Objects resting directly inside / on top of ``name``."""
@@ -326,18 +265,3 @@ class World:
         for d in self.descendants(obj.name):
             d.center = d.center + delta
             d.room = obj.room
-
-
-def _alpha(i: int) -> str:
-    """0 -> A, 25 -> Z, 26 -> AA, ... (spreadsheet-style column letters)."""
-    letters = ""
-    i += 1
-    while i:
-        i, rem = divmod(i - 1, 26)
-        letters = string.ascii_uppercase[rem] + letters
-    return letters
-
-
-def _natural_key(name: str) -> list[object]:
-    """Sort 'apple_2' before 'apple_10'."""
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]

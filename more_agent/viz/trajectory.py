@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
 
+from more_agent.sim.labels import InstanceLabels  # noqa: E402
 from more_agent.sim.world import World  # noqa: E402
 from more_agent.viz.plan import draw_plan, plan_figure  # noqa: E402
 
@@ -32,7 +33,7 @@ def draw_trajectory(ax: Axes, trajectory: Sequence[tuple[float, float]], *, colo
     ax.plot(xs[-1], ys[-1], "s", color=color, ms=7, zorder=11, label="end")
 
 
-def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) -> None:
+def draw_items(ax: Axes, world: World, labels: InstanceLabels, labelled: Collection[str] | None = None) -> None:
     """Items as small dots, with their labels (only for ``labelled`` names when given: a store holds
     hundreds of items), so the map shows where things ended up."""
     items = [o for o in world.items() if world.robot.held != o.name]
@@ -42,7 +43,7 @@ def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) 
     for obj in items:
         if labelled is None or obj.name in labelled:
             ax.annotate(
-                world.display_label(obj.name),
+                labels.display(obj),
                 (obj.center[0], obj.center[1]),
                 fontsize=5,
                 zorder=9,
@@ -53,6 +54,7 @@ def draw_items(ax: Axes, world: World, labelled: Collection[str] | None = None) 
 
 def trajectory_map_png(
     world: World,
+    labels: InstanceLabels,
     trajectory: Sequence[tuple[float, float]],
     *,
     title: str = "",
@@ -64,7 +66,7 @@ def trajectory_map_png(
     try:
         open_state = {o.name: o.is_open for o in world.objects.values() if o.openable}
         draw_plan(ax, world.scene, open_state=open_state)
-        draw_items(ax, world, labelled)
+        draw_items(ax, world, labels, labelled)
         draw_trajectory(ax, trajectory)
         ax.set_title(title, fontsize=9)
         buf = io.BytesIO()

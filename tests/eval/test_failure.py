@@ -9,7 +9,8 @@ import pytest
 from more_agent.eval.failure import cause_counts, classify_failure
 from more_agent.eval.report import summary_markdown
 from more_agent.records import ActionRecord, EpisodeRecord, FailureReason, GoalCondition
-from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.scene import load_scene
 from more_agent.sim.world import World
 
@@ -17,10 +18,20 @@ KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
 
 @pytest.fixture(scope="module")
-def world() -> World:
-    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
-    world.assign_labels()  # as after an episode that saw everything: the causes name objects by label
-    return world
+def kitchen() -> TaskInstance:
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    inst.labels.assign_all(inst.world)  # as after an episode that saw everything: the causes name objects by label
+    return inst
+
+
+@pytest.fixture
+def world(kitchen: TaskInstance) -> World:
+    return kitchen.world
+
+
+@pytest.fixture
+def labels(kitchen: TaskInstance) -> InstanceLabels:
+    return kitchen.labels
 
 
 def _record(**fields: object) -> EpisodeRecord:
@@ -35,9 +46,9 @@ def _act(name: str, target: str, ok: bool, feedback: str = "", reason: FailureRe
     return ActionRecord(step=0, name=name, arguments=["kitchen_0", target], ok=ok, feedback=feedback, reason=reason)
 
 
-def test_each_cause_from_the_trace(world: World) -> None:
+def test_each_cause_from_the_trace(world: World, labels: InstanceLabels) -> None:
     def cause(record: EpisodeRecord) -> str | None:
-        failure = classify_failure(record, world)
+        failure = classify_failure(record, world, labels)
         return None if failure is None else failure.cause
 
     assert cause(_record(success=True, all_goals_met=True, done_called=True)) is None
@@ -60,35 +71,37 @@ def test_each_cause_from_the_trace(world: World) -> None:
     assert cause(_record(actions=invalid)) == "invalid_llm_answers"
     assert cause(_record(done_called=True, termination="done")) == "done_early"
     assert cause(_record(high_level_steps=50, termination="step_limit")) == "step_limit"
-    detail = classify_failure(_record(observed_objects=["bottom_cabinet_0"]), world)
+    detail = classify_failure(_record(observed_objects=["bottom_cabinet_0"]), world, labels)
     assert detail is not None and detail.detail == "never observed canned_food A"  # labels, as the robot knows them
 
 
-def test_causes_read_types_not_text(world: World) -> None:
+def test_causes_read_types_not_text(world: World, labels: InstanceLabels) -> None:
     """Feedback and error text that reads like another cause changes nothing: only the typed fields count."""
     worded = _act("go_to_and_grasp", "canned_food A", False, "cannot reach canned_food A: no path on the map",
                   FailureReason.HAND_FULL)
-    assert classify_failure(_record(actions=[worded]), world).cause == "subpolicy_failure"  # type: ignore[union-attr]
+    assert classify_failure(_record(actions=[worded]), world, labels).cause == "subpolicy_failure"  # type: ignore[union-attr]
     named_invalid = [ActionRecord(step=i, name="invalid", ok=False) for i in range(3)]
-    assert classify_failure(_record(actions=named_invalid), world).cause != "invalid_llm_answers"  # type: ignore[union-attr]
-    ended = classify_failure(_record(high_level_steps=50, termination="step_limit"), world)
+    assert classify_failure(_record(actions=named_invalid), world, labels).cause != "invalid_llm_answers"  # type: ignore[union-attr]
+    ended = classify_failure(_record(high_level_steps=50, termination="step_limit"), world, labels)
     assert ended is not None and ended.detail.startswith("step limit of 50 high-level steps reached; ")
-    gave_up = classify_failure(_record(done_called=True, termination="done", gave_up="nothing fits"), world)
+    gave_up = classify_failure(_record(done_called=True, termination="done", gave_up="nothing fits"), world, labels)
     assert gave_up is not None and (gave_up.cause, gave_up.detail) == ("done_early", "nothing fits")
 
 
-def test_summary_counts_causes_per_system(world: World) -> None:
+def test_summary_counts_causes_per_system(world: World, labels: InstanceLabels) -> None:
     records = [_record(observed_objects=[]), _record(done_called=True), _record(success=True, all_goals_met=True)]
-    records = [r.model_copy(update={"failure": classify_failure(r, world)}) for r in records]
+    records = [r.model_copy(update={"failure": classify_failure(r, world, labels)}) for r in records]
     assert cause_counts(records) == {"never_observed": 1, "done_early": 1}
     md = summary_markdown(records)
     assert "| System | n | failures | never_observed | done_early |\n" in md and "| grounded | 3 | 2 | 1 | 1 |" in md
 
 
 def test_a_wrong_instance_names_a_needed_one_never_seen_by_its_world_name() -> None:
-    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
-    world.assign_labels()
-    world.get("bottom_cabinet_0").label = ""  # the needed cabinet was never seen, so never labelled
-    failure = classify_failure(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)]), world)
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    world, labels = inst.world, InstanceLabels()
+    labels.observe(o for o in world.objects.values() if o.name != "bottom_cabinet_0")  # the needed one never seen
+    other = labels.label("bottom_cabinet_1")
+    assert other.startswith("bottom_cabinet ")
+    failure = classify_failure(_record(actions=[_act("go_to_and_place_inside", other, True)]), world, labels)
     assert failure is not None and failure.cause == "wrong_instance"
     assert failure.detail.endswith("the goal needs bottom_cabinet_0 (never observed)")

@@ -21,8 +21,8 @@ TASK = "putting_shopping_away"
 def looked_around(perception: str) -> tuple[TaskInstance, Embodiment, SceneGraph, NoisyPerception | None]:
     """The kitchen task after the initial full turn, perceived in mode ``perception``."""
     inst = instantiate_in_scene(TASK, load_scene(KITCHEN), seed=0, start="task-room")
-    noise = perception_for(perception, inst.world, 0, TASK)
-    robot = SimRobot(inst.world)
+    noise = perception_for(perception, inst.world, inst.labels, 0, TASK)
+    robot = SimRobot(inst.world, labels=inst.labels)
     body = Embodiment(robot if noise is None else NoisyRobot(robot, noise))
     body.look_around()
     return inst, body, body.build(), noise
@@ -30,9 +30,9 @@ def looked_around(perception: str) -> tuple[TaskInstance, Embodiment, SceneGraph
 
 def test_ground_truth_builds_no_perception_and_all_kinds_off_neither() -> None:
     inst = instantiate_in_scene(TASK, load_scene(KITCHEN), seed=0, start="task-room")
-    assert perception_for("gt", inst.world, 0, TASK) is None
+    assert perception_for("gt", inst.world, inst.labels, 0, TASK) is None
     off = "noisy:confusion=0,miss=0,fragment=0,merge=0,depth=0,drift=0,room=0"
-    assert perception_for(off, inst.world, 0, TASK) is None
+    assert perception_for(off, inst.world, inst.labels, 0, TASK) is None
 
 
 def test_a_noisy_episode_replays_exactly() -> None:
@@ -50,8 +50,8 @@ def test_confused_objects_get_a_label_of_the_category_seen_and_act_as_the_real_o
         real = inst.world.get(name)
         node = graph.objects.get(label)
         assert node is None or node.category == label.rsplit(" ", 1)[0] != real.category
-        assert noise.real_label(label) == real.label and inst.world.by_label(label) is None  # never the world's
-        assert real.label not in graph.objects and name not in noise.observed()  # seen, but not as itself
+        assert noise.real_label(label) == inst.labels.label(name) and inst.labels.find(label) is None  # no object's
+        assert inst.labels.label(name) not in graph.objects and name not in noise.observed()  # seen, but not as itself
     item = next(
         (
             graph.objects[lbl]

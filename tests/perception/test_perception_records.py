@@ -12,9 +12,8 @@ from more_agent.errors import UserError
 from more_agent.eval.failure import classify_failure
 from more_agent.eval.store import RunConfig, check_same_run, episode_dirname, pending
 from more_agent.records import RECORD_SCHEMA_VERSION, ActionRecord, EpisodeRecord, EpisodeSpec, GoalCondition
-from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.scene import load_scene
-from more_agent.sim.world import World
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -48,10 +47,10 @@ def test_resume_key_and_folder_name_tell_the_modes_apart(tmp_path: Path) -> None
 
 
 @pytest.fixture(scope="module")
-def world() -> World:
-    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0).world
-    world.assign_labels()
-    return world
+def kitchen() -> TaskInstance:
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    inst.labels.assign_all(inst.world)  # as after an episode that saw everything: the causes name objects by label
+    return inst
 
 
 def _record(**fields: object) -> EpisodeRecord:
@@ -71,24 +70,25 @@ def _record(**fields: object) -> EpisodeRecord:
     return EpisodeRecord(**{**base, **fields})
 
 
-def test_misperceived_names_the_needed_object_perception_hid_or_the_mislabelled_one_acted_on(world: World) -> None:
-    plain = classify_failure(_record(), world)
+def test_misperceived_names_the_needed_object_perception_hid_or_the_mislabelled_one_acted_on(kitchen: TaskInstance) -> None:
+    world, labels = kitchen.world, kitchen.labels
+    plain = classify_failure(_record(), world, labels)
     assert plain is not None and plain.cause == "never_observed"  # ground truth: as before
-    hidden = classify_failure(_record(misperceived={"canned_food_1": "seen as soup_can C"}), world)
+    hidden = classify_failure(_record(misperceived={"canned_food_1": "seen as soup_can C"}), world, labels)
     assert hidden is not None and hidden.cause == "misperceived"
-    assert hidden.detail == f"{world.get('canned_food_1').label}: seen as soup_can C"
+    assert hidden.detail == f"{labels.label('canned_food_1')}: seen as soup_can C"
     grasp = ActionRecord(step=0, name="go_to_and_grasp", arguments=["kitchen_0", "bowl C"], ok=True)
     acted = _record(
         actions=[grasp],
         perception_aliases={"bowl C": "canned_food_1"},
         observed_objects=["canned_food_1", "bottom_cabinet_0"],
     )
-    failure = classify_failure(acted, world)
+    failure = classify_failure(acted, world, labels)
     assert failure is not None and failure.cause == "misperceived" and "acted on bowl C, which is" in failure.detail
     piece = _record(
         actions=[grasp.model_copy(update={"arguments": ["kitchen_0", "canned_food C"]})],
         perception_aliases={"canned_food C": "canned_food_1"},
         observed_objects=["canned_food_1", "bottom_cabinet_0"],
     )
-    other = classify_failure(piece, world)
+    other = classify_failure(piece, world, labels)
     assert other is not None and other.cause != "misperceived"  # a second piece of the same category is no mislabel

@@ -16,7 +16,7 @@ from more_agent.sim.env import SimRobot
 from more_agent.sim.goals import GoalChecker, Literal, PrivilegedContext
 from more_agent.sim.predicates import ROBOT_NAME
 from more_agent.sim.world import World
-from tests.sim.test_navgrid import two_room_world
+from tests.sim.test_navgrid import labelled, two_room_world
 
 SCOPES = {
     "apple_0": "apple.n.01_1", "bowl_0": "bowl.n.01_1", "box_0": "carton.n.02_1",
@@ -55,7 +55,7 @@ def bddl_goals(world: World, goal: list[Literal]) -> GoalChecker:
 def solve(world: World, goals: GoalChecker, max_steps: int = 50) -> tuple[list[tuple[str, tuple[str, ...], bool]], str]:
     planner = OraclePlanner()
     planner.grant(PrivilegedContext(world=world, goals=goals))
-    planner.reset(EpisodeContext(robot=SimRobot(world), goal=GoalSpec(text="")))
+    planner.reset(EpisodeContext(robot=SimRobot(world, labels=labelled(world)), goal=GoalSpec(text="")))
     log = []
     for _ in range(max_steps):
         planner.observe()

@@ -31,7 +31,7 @@ KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 def fresh() -> tuple[TaskInstance, Embodiment, SceneGraph]:
     """A kitchen task instance after the initial full turn, and its scene graph (the robot starts in the kitchen)."""
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
-    body = Embodiment(SimRobot(inst.world))
+    body = Embodiment(SimRobot(inst.world, labels=inst.labels))
     body.look_around()
     return inst, body, body.build()
 

@@ -35,7 +35,7 @@ def test_the_angle_stays_below_the_cameras_field_of_view() -> None:
 @pytest.mark.parametrize("distance_m", [0.3, 0.6])
 def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_m: float) -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
-    body = Embodiment(SimRobot(inst.world), config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
+    body = Embodiment(SimRobot(inst.world, labels=inst.labels), config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
     body.sense()  # the frame where the robot stands
     frames: list[tuple[float, float]] = []
     body.on_frame = lambda frame: frames.append(body.xy)

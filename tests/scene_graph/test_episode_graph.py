@@ -11,6 +11,7 @@ from collections import Counter
 
 from more_agent.planners.policies import Embodiment
 from more_agent.sim.env import SimRobot
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import nav_grid
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.world import World
@@ -21,7 +22,8 @@ def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> Non
     for door in world.scene.doors:
         world.set_open(door.id, True)
     grid = nav_grid(world)
-    body = Embodiment(SimRobot(world))
+    labels = InstanceLabels()
+    body = Embodiment(SimRobot(world, labels=labels))
     centres = [((r.bounds[0] + r.bounds[2]) / 2, (r.bounds[1] + r.bounds[3]) / 2) for r in world.scene.rooms]
     doors = [((d.bounds()[0] + d.bounds()[2]) / 2, (d.bounds()[1] + d.bounds()[3]) / 2) for d in world.scene.doors]
     for x, y in centres + doors:  # as a robot driving from room to room sees them: the doors it passes too
@@ -36,8 +38,7 @@ def test_explored_rs_int_graph_has_one_region_per_room_with_its_objects() -> Non
         region_room[rid] = next(iter(rooms))
     assert sorted(region_room.values()) == sorted(r.id for r in world.scene.rooms)
 
-    by_label = {o.label: o for o in world.objects.values()}
     placed = [o for o in graph.objects.values() if o.category != "door" and o.region_id is not None]
     assert len(placed) >= 20
     for obj in placed:
-        assert region_room[obj.region_id] == by_label[obj.label].room, obj.label
+        assert region_room[obj.region_id] == world.get(labels.find(obj.label) or obj.label).room, obj.label

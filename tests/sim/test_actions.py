@@ -20,64 +20,70 @@ from more_agent.sim.actions import (
     place_inside,
     place_ontop,
 )
-from tests.sim.test_navgrid import two_room_world
+from tests.sim.test_navgrid import labelled, two_room_world
 
 
 def test_hidden_item_cannot_be_grasped_until_container_opened():
     world = two_room_world()
+    labels = labelled(world)
     assert not world.is_observable("apple_0")
-    result = go_to_and(world, "grasp", "apple_0")
+    result = go_to_and(world, "grasp", "apple_0", labels)
     assert not result.ok and result.reason is FailureReason.HIDDEN
     assert "must open fridge A first" in result.feedback
-    assert go_to_and(world, "open", "fridge_0").ok
+    assert go_to_and(world, "open", "fridge_0", labels).ok
     assert world.is_observable("apple_0")
-    assert go_to_and(world, "grasp", "apple_0").ok and world.robot.held == "apple_0"
+    assert go_to_and(world, "grasp", "apple_0", labels).ok and world.robot.held == "apple_0"
 
 
 def test_hand_rules_for_grasp_open_close_and_place():
     world = two_room_world()
-    assert place_ontop(world, "table_0").reason is FailureReason.HAND_EMPTY
-    assert go_to_and(world, "grasp", "box_0").ok
-    assert grasp(world, "bowl_0").reason is FailureReason.HAND_FULL
-    full = go_to_and(world, "open", "fridge_0")
+    labels = labelled(world)
+    assert place_ontop(world, "table_0", labels).reason is FailureReason.HAND_EMPTY
+    assert go_to_and(world, "grasp", "box_0", labels).ok
+    assert grasp(world, "bowl_0", labels).reason is FailureReason.HAND_FULL
+    full = go_to_and(world, "open", "fridge_0", labels)
     assert not full.ok and full.reason is FailureReason.HAND_FULL and full.feedback.startswith("hand is full")
     assert full.path == []  # a doomed action costs no motion
-    placed = go_to_and(world, "place_ontop", "table_0")
+    placed = go_to_and(world, "place_ontop", "table_0", labels)
     assert placed.ok and world.get("box_0").parent == "table_0" and world.robot.held is None
 
 
 def test_open_close_preconditions():
     world = two_room_world()
-    assert go_to_and(world, "open", "table_0").reason is FailureReason.NOT_OPENABLE
-    assert go_to_and(world, "close", "fridge_0").reason is FailureReason.ALREADY_CLOSED
-    assert go_to_and(world, "open", "fridge_0").ok
-    assert open_(world, "fridge_0").reason is FailureReason.ALREADY_OPEN
-    assert close(world, "fridge_0").ok and not world.get("fridge_0").is_open
-    assert grasp(world, "table_0").reason is FailureReason.NOT_GRASPABLE
-    assert grasp(world, "nothing_9").reason is FailureReason.UNKNOWN_OBJECT
+    labels = labelled(world)
+    assert go_to_and(world, "open", "table_0", labels).reason is FailureReason.NOT_OPENABLE
+    assert go_to_and(world, "close", "fridge_0", labels).reason is FailureReason.ALREADY_CLOSED
+    assert go_to_and(world, "open", "fridge_0", labels).ok
+    assert open_(world, "fridge_0", labels).reason is FailureReason.ALREADY_OPEN
+    assert close(world, "fridge_0", labels).ok and not world.get("fridge_0").is_open
+    assert grasp(world, "table_0", labels).reason is FailureReason.NOT_GRASPABLE
+    assert grasp(world, "nothing_9", labels).reason is FailureReason.UNKNOWN_OBJECT
 
 
 def test_place_inside_needs_open_target_and_valid_target():
     world = two_room_world()
-    assert go_to_and(world, "grasp", "box_0").ok
-    closed = go_to_and(world, "place_inside", "fridge_0")
+    labels = labelled(world)
+    assert go_to_and(world, "grasp", "box_0", labels).ok
+    closed = go_to_and(world, "place_inside", "fridge_0", labels)
     assert closed.reason is FailureReason.TARGET_CLOSED and closed.feedback == "must open fridge A first"
-    assert place_inside(world, "door_0").reason is FailureReason.INVALID_TARGET
-    assert place_inside(world, "floor_kitchen_0").reason is FailureReason.INVALID_TARGET
+    assert place_inside(world, "door_0", labels).reason is FailureReason.INVALID_TARGET
+    assert place_inside(world, "floor_kitchen_0", labels).reason is FailureReason.INVALID_TARGET
 
 
 def test_manipulation_needs_reach():
     world = two_room_world()
+    labels = labelled(world)
     world.set_robot_pose(1.0, 0.5, 0.0)
     assert distance_to_footprint(world, "bowl_0") > REACH_M
-    far = grasp(world, "bowl_0")
+    far = grasp(world, "bowl_0", labels)
     assert far.reason is FailureReason.TOO_FAR and world.robot.held is None
 
 
 def test_navigate_ends_free_within_reach_facing_object_and_counts_steps():
     world = two_room_world()
+    labels = labelled(world)
     start = (world.robot.x, world.robot.y)
-    result = navigate_to(world, "bowl_0")
+    result = navigate_to(world, "bowl_0", labels)
     assert result.ok and result.path[0] == start
     end = (world.robot.x, world.robot.y)
     assert result.path[-1] == end and distance_to_footprint(world, "bowl_0") <= REACH_M
@@ -89,22 +95,24 @@ def test_navigate_ends_free_within_reach_facing_object_and_counts_steps():
 
 def test_closed_door_blocks_navigation_with_the_door_named_then_opening_it_helps():
     world = two_room_world(door_open=False)
-    blocked = go_to_and(world, "grasp", "bowl_0")
+    labels = labelled(world)
+    blocked = go_to_and(world, "grasp", "bowl_0", labels)
     assert blocked.reason is FailureReason.PATH_BLOCKED_BY_DOOR and blocked.blocking == "door_0"
     assert "door A" in blocked.feedback
-    assert go_to_and(world, "open", "door_0").ok
+    assert go_to_and(world, "open", "door_0", labels).ok
     assert world.robot.x < 5.0  # opened from the kitchen side
-    assert go_to_and(world, "grasp", "bowl_0").ok
+    assert go_to_and(world, "grasp", "bowl_0", labels).ok
 
 
 def test_contents_travel_with_their_container():
     world = two_room_world()
-    assert go_to_and(world, "grasp", "box_0").ok
-    assert go_to_and(world, "place_ontop", "table_0").ok
-    assert go_to_and(world, "grasp", "bowl_0").ok
-    assert go_to_and(world, "place_inside", "box_0").ok
-    assert go_to_and(world, "grasp", "box_0").ok
-    assert go_to_and(world, "place_ontop", "floor_kitchen_0").ok
+    labels = labelled(world)
+    assert go_to_and(world, "grasp", "box_0", labels).ok
+    assert go_to_and(world, "place_ontop", "table_0", labels).ok
+    assert go_to_and(world, "grasp", "bowl_0", labels).ok
+    assert go_to_and(world, "place_inside", "box_0", labels).ok
+    assert go_to_and(world, "grasp", "box_0", labels).ok
+    assert go_to_and(world, "place_ontop", "floor_kitchen_0", labels).ok
     box, bowl = world.get("box_0"), world.get("bowl_0")
     assert bowl.parent == "box_0" and bowl.room == "kitchen_0"
     assert abs(bowl.center[0] - box.center[0]) < box.size[0] / 2

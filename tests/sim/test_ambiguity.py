@@ -20,9 +20,9 @@ def test_the_checkout_of_a_store_with_two_is_ambiguous_in_the_papers_words() -> 
 
 def test_the_default_description_names_the_goals_checkout_by_its_label() -> None:
     inst = instantiate("buy_eggs", "grocery_store_cafe", 0, start="task-room", distractors=False)
-    checkout = inst.world.objects[inst.scope["checkout.n.03_1"]]
+    checkout = inst.labels.label(inst.scope["checkout.n.03_1"])
     assert inst.descriptions == "named" and inst.description.startswith("put egg A and money on the checkout. ")
-    assert f"on top of {checkout.label}" in inst.description and checkout.label.startswith("checkout_counter ")
+    assert f"on top of {checkout}" in inst.description and checkout.startswith("checkout_counter ")
     assert ambiguous_scopes(inst) == [] and "checkout.n.03_1" in described_scopes(inst)
 
 
@@ -33,20 +33,20 @@ def test_a_distractor_of_a_goal_items_category_makes_it_ambiguous_until_named() 
     assert any(o.category == paper.world.objects[apple].category for o in paper.world.objects.values() if o.name in paper.distractors)
     assert "apple.n.01_1" in ambiguous_scopes(paper)
     named = instantiate("bag_groceries", seed=0)
-    assert named.world.objects[apple].label in named.description and ambiguous_scopes(named) == []
+    assert named.labels.label(apple) in named.description and ambiguous_scopes(named) == []
 
 
 def test_a_quantifier_over_items_distractors_share_lists_the_instances_it_ranges_over() -> None:
     # boxing_books_up_for_storage: "every book" of the goal is the task's six, not the house's own.
     inst = instantiate("boxing_books_up_for_storage", seed=0)
-    books = [inst.world.objects[inst.scope[f"book.n.02_{i}"]].label for i in range(1, 7)]
+    books = [inst.labels.label(inst.scope[f"book.n.02_{i}"]) for i in range(1, 7)]
     assert "The book(s) meant are " + ", ".join(books[:-1]) + f" and {books[-1]}." in inst.description
     assert ambiguous_scopes(inst) == []
 
 
 def test_the_default_description_states_the_goal_conditions_the_papers_text_leaves_out() -> None:
     inst = instantiate("preparing_lunch_box", seed=0)
-    fridge = inst.world.objects[inst.scope["electric_refrigerator.n.01_1"]].label
+    fridge = inst.labels.label(inst.scope["electric_refrigerator.n.01_1"])
     assert f". Close {fridge} when done." in inst.description
     assert "Close" not in instantiate("preparing_lunch_box", seed=0, descriptions="paper").description
 

@@ -75,11 +75,11 @@ def test_hand_built_scene_binds_labels_and_describes() -> None:
     assert inst.scope["agent.n.01_1"] == "robot"
     assert inst.scope["pack__of__ground_beef.n.01_1"] == "pack__of__ground_beef_1"
     beef = world.get("pack__of__ground_beef_1")
-    assert beef.label == ""  # not named by the description: labelled when first observed
-    assert world.get("fridge_0").label == "fridge A"  # named by it: reserved up front
+    assert inst.labels.label(beef.name) == ""  # not named by the description: labelled when first observed
+    assert inst.labels.label("fridge_0") == "fridge A"  # named by it: reserved up front
     assert world.is_inside("pack__of__ground_beef_1", "sack_1")
     assert world.get("sack_1").parent == "floor_kitchen_0"
-    cabinet = world.get(inst.scope["cabinet.n.01_1"]).label
+    cabinet = inst.labels.label(inst.scope["cabinet.n.01_1"])
     assert inst.description == f"store dairy and meat in fridge A, and other food and oil in {cabinet}"
     assert world.room_at(world.robot.x, world.robot.y) == "kitchen_0"
     assert inst.unsupported_literals == []
@@ -127,8 +127,9 @@ def test_open_literals_and_closed_containers() -> None:
 _DIGEST = """
 import hashlib
 from more_agent.sim.instantiate import instantiate
-world = instantiate("putting_dishes_away_after_cleaning", None, 2).world
-state = sorted((o.name, o.instance_id, o.parent, o.relation, o.label, tuple(o.center.round(4))) for o in world.objects.values())
+inst = instantiate("putting_dishes_away_after_cleaning", None, 2)
+world = inst.world
+state = sorted((o.name, o.instance_id, o.parent, o.relation, inst.labels.label(o.name), tuple(o.center.round(4))) for o in world.objects.values())
 print(hashlib.sha256(repr(state).encode()).hexdigest())
 """
 

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import NavConfig, blocking_door, free_cells, nav_grid, reachable, shortest_path
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall
 from more_agent.sim.world import World, WorldObject
@@ -41,9 +42,15 @@ def two_room_world(door_open: bool = True) -> World:
     world.place("apple_0", "fridge_0", "inside")
     world.place("bowl_0", "table_0", "ontop")
     world.place_on_floor_at("box_0", "floor_kitchen_0", (3.0, 3.0))
-    world.assign_labels()
     world.set_robot_pose(2.5, 1.0, 0.0)
     return world
+
+
+def labelled(world: World) -> InstanceLabels:
+    """Labels for every object of ``world``, as after a walk that saw them all ('fridge A')."""
+    labels = InstanceLabels()
+    labels.assign_all(world)
+    return labels
 
 
 def test_free_space_excludes_walls_furniture_and_keeps_clearance():

@@ -9,7 +9,8 @@ import pytest
 
 from more_agent.robot_spec import OMNIGIBSON_FETCH_HFOV_DEG
 from more_agent.sim.camera import Camera, camera_pose, project
-from more_agent.sim.render import Renderer, instance_table, render, scene_geometry
+from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.render import Renderer, render, scene_geometry
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall, Window
 from more_agent.sim.world import World, WorldObject
 
@@ -44,7 +45,6 @@ def two_rooms() -> World:
     world.place("apple_0", "fridge_0", "inside")
     world.add(WorldObject(name="mug_0", category="mug", kind="item", center=np.zeros(3), size=np.array([0.1, 0.1, 0.12])))
     world.place("mug_0", "table_0", "ontop")
-    world.assign_labels()
     return world
 
 
@@ -105,22 +105,24 @@ def test_semantic_and_instance_of_a_known_object():
     assert frame.semantic[v, u] == world.class_names.index("fridge")
     assert frame.instance[v, u] == fridge.instance_id
     assert back_project(frame, v, u)[1] == pytest.approx(3.15, abs=1e-3)
-    table = instance_table(world, frame.instance)
+    table = InstanceLabels().table(world, frame.instance)
     assert table[fridge.instance_id] == {"name": "fridge_0", "label": "fridge A", "category": "fridge", "open": False, "held": False}
 
 
 def test_instance_ids_name_the_objects_after_objects_come_and_go():
-    """``World.by_instance_ids`` (read every frame by ``instance_table``) keeps no stale entry when an
-    object is removed and another added under its id."""
-    world = two_rooms()
+    """``InstanceLabels.table`` (read every frame) looks objects up by id through a cache that keeps no
+    stale entry when an object is removed and another added under its id."""
+    world, labels = two_rooms(), InstanceLabels()
     fridge = world.get("fridge_0")
-    assert world.by_instance_ids([fridge.instance_id]) == {fridge.instance_id: fridge}
+    assert labels.table(world, np.array([[0, fridge.instance_id]]))[fridge.instance_id]["name"] == "fridge_0"
     last = max(world.objects.values(), key=lambda o: o.instance_id)
     del world.objects[last.name]
     new = world.add(WorldObject(name="mug_9", category="mug", kind="item", room=last.room, center=np.zeros(3),
                                 size=np.full(3, 0.1)))
     assert new.instance_id == last.instance_id
-    assert world.by_instance_ids([new.instance_id, fridge.instance_id]) == {new.instance_id: new, fridge.instance_id: fridge}
+    table = labels.table(world, np.array([[new.instance_id, fridge.instance_id]]))
+    assert {i: row["name"] for i, row in table.items()} == {new.instance_id: "mug_9", fridge.instance_id: "fridge_0"}
+    assert table[new.instance_id]["label"] == "mug A"
 
 
 def test_fridge_content_hidden_until_opened():
@@ -132,7 +134,7 @@ def test_fridge_content_hidden_until_opened():
     world.set_open("fridge_0", True)
     frame = renderer.render(world)
     assert apple in frame.instance
-    assert instance_table(world, frame.instance)[world.get("fridge_0").instance_id]["open"] is True
+    assert InstanceLabels().table(world, frame.instance)[world.get("fridge_0").instance_id]["open"] is True
 
 
 def test_open_container_keeps_its_full_box():
@@ -173,7 +175,7 @@ def test_items_rest_at_their_heights_and_held_items_vanish():
     world.pick("mug_0")
     after = render(world)
     assert mug.instance_id not in after.instance
-    assert instance_table(world, after.instance)[mug.instance_id]["held"] is True
+    assert InstanceLabels().table(world, after.instance)[mug.instance_id]["held"] is True
 
 
 def test_window_is_see_through_and_range_is_five_metres():

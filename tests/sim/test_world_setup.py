@@ -21,7 +21,7 @@ from more_agent.sim.clutter import (
 )
 from more_agent.sim.instantiate import instantiate, instantiate_in_scene
 from more_agent.sim.navgrid import nav_grid, shortest_path
-from more_agent.sim.render import Renderer, instance_table
+from more_agent.sim.render import Renderer
 from more_agent.sim.scene import load_scene, save_scene
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.start import random_start
@@ -155,32 +155,34 @@ def test_grocery_store_is_cluttered_and_deterministic() -> None:
 # -- labels in order of observation -----------------------------------------------------------------
 def test_labels_follow_observation_and_reveal_no_unseen_instance() -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2)
-    world = inst.world
-    named = {o.name for o in world.objects.values() if o.label}
+    world, labels = inst.world, inst.labels
+    named = {o.name for o in world.objects.values() if labels.label(o.name)}
     assert named == {"fridge_0", inst.scope["cabinet.n.01_1"]}  # only what the description names
     assert "fridge A" in inst.description
     renderer = Renderer()
     seen: list[str] = []
     for k in range(12):
         world.set_robot_pose(world.robot.x, world.robot.y, k * np.pi / 6)
-        table = instance_table(world, renderer.render(world).instance)
+        version = world.version
+        table = labels.table(world, renderer.render(world).instance)
+        assert world.version == version  # seeing and labelling change nothing in the world
         seen += [d["name"] for d in table.values() if d["name"] not in seen]
         assert all(d["label"] for d in table.values() if world.get(d["name"]).kind != "floor")
     by_category: dict[str, list[str]] = {}
     for o in world.objects.values():
-        if o.label:
-            by_category.setdefault(o.category, []).append(o.label.rsplit(" ", 1)[1])
+        if labels.label(o.name):
+            by_category.setdefault(o.category, []).append(labels.label(o.name).rsplit(" ", 1)[1])
     for letters in by_category.values():  # per category the letters handed out are A, B, C, ... without gaps
         assert sorted(letters, key=lambda s: (len(s), s)) == [chr(ord("A") + i) for i in range(len(letters))]
     unseen = [o for o in world.objects.values() if o.name not in seen and o.kind != "floor" and o.name not in named]
-    assert all(o.label == "" and world.display_label(o.name) == o.category for o in unseen)
+    assert all(labels.label(o.name) == "" and labels.display(o) == o.category for o in unseen)
 
 
-def test_assign_labels_names_the_rest_after_the_reserved() -> None:
-    world = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2).world
-    world.assign_labels()
-    assert world.get("fridge_0").label == "fridge A"
-    cabinets = sorted(o.label for o in world.objects.values() if o.category == "bottom_cabinet")
+def test_assign_all_labels_the_rest_after_the_reserved() -> None:
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2)
+    inst.labels.assign_all(inst.world)
+    assert inst.labels.label("fridge_0") == "fridge A"
+    cabinets = sorted(inst.labels.label(o.name) for o in inst.world.objects.values() if o.category == "bottom_cabinet")
     assert cabinets == ["bottom_cabinet A", "bottom_cabinet B"]
 
 
