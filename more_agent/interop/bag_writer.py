@@ -6,7 +6,7 @@ instance images (16UC1, 32SC1 past 65535), the camera info, ``/tf`` map -> base_
 a PoseStamped, and the label table: the classes, every instance in view, the held item, what the robot
 just opened or closed out of view and what it just put down (with its box) -- what the robot's own
 perception and proprioception tell its mapping (``planners.policies.embodiment.Embodiment.sense``).
-``/tf_static`` holds base_link -> the optical frame once.
+``/tf`` also holds base_link -> the optical frame with every frame: the head pans and tilts.
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ from more_agent.interop.bag_contract import (
     POSE,
     STRING,
     TF,
-    TF_STATIC_TOPIC,
     TF_TOPIC,
     BagTopics,
     InstanceLabel,
@@ -76,7 +75,6 @@ class BagRecorder:
             (t.instance, IMAGE),
             (t.camera_info, CAMERA_INFO),
             (TF_TOPIC, TF),
-            (TF_STATIC_TOPIC, TF),
             (POSE_TOPIC, POSE),
             (t.labels, STRING),
         ):
@@ -95,11 +93,12 @@ class BagRecorder:
         T_world_base = pose_matrix(
             (world.robot.x, world.robot.y, 0.0), (0.0, 0.0, np.sin(world.robot.yaw / 2), np.cos(world.robot.yaw / 2))
         )
-        if self.frames == 0:
-            T_base_cam = np.linalg.inv(T_world_base) @ frame.T_world_cam
-            self._write(TF_STATIC_TOPIC, t_ns, self._tf(t_ns, t.base_frame, CAMERA_FRAME, T_base_cam))
+        T_base_cam = np.linalg.inv(T_world_base) @ frame.T_world_cam
         self._write(t.labels, t_ns, self._msg(STRING, data=self._label_table(world, labels, frame).model_dump_json()))
-        self._write(TF_TOPIC, t_ns, self._tf(t_ns, t.world_frame, t.base_frame, T_world_base))
+        # the head pans and tilts (Robot.sense's head pose), so base -> camera is a moving joint as on a
+        # real Fetch: on /tf with every frame, beside map -> base, rather than once on /tf_static
+        tf = self._tf(t_ns, (t.world_frame, t.base_frame, T_world_base), (t.base_frame, CAMERA_FRAME, T_base_cam))
+        self._write(TF_TOPIC, t_ns, tf)
         position, q = matrix_pose(frame.T_world_cam)
         types = self._store.types
         self._write(
@@ -193,16 +192,21 @@ class BagRecorder:
     def _quat(self, q: np.ndarray) -> Any:
         return self._store.types["geometry_msgs/msg/Quaternion"](*map(float, q))
 
-    def _tf(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> Any:
+    def _tf(self, t_ns: int, *edges: tuple[str, str, np.ndarray]) -> Any:
+        """One TFMessage holding each (parent, child, T_parent_child) edge, stamped ``t_ns``."""
         types = self._store.types
-        translation, q = matrix_pose(T)
-        transform = types["geometry_msgs/msg/Transform"](
-            translation=types["geometry_msgs/msg/Vector3"](*map(float, translation)), rotation=self._quat(q)
-        )
-        stamped = types["geometry_msgs/msg/TransformStamped"](
-            header=self._header(t_ns, parent), child_frame_id=child, transform=transform
-        )
-        return self._msg(TF, transforms=[stamped])
+        stamped = []
+        for parent, child, T in edges:
+            translation, q = matrix_pose(T)
+            transform = types["geometry_msgs/msg/Transform"](
+                translation=types["geometry_msgs/msg/Vector3"](*map(float, translation)), rotation=self._quat(q)
+            )
+            stamped.append(
+                types["geometry_msgs/msg/TransformStamped"](
+                    header=self._header(t_ns, parent), child_frame_id=child, transform=transform
+                )
+            )
+        return self._msg(TF, transforms=stamped)
 
     def _camera_info(self, header: Any, frame: Frame) -> Any:
         h, w = frame.depth.shape

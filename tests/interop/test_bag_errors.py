@@ -19,8 +19,8 @@ from tests.interop.bags import rewrite_bag
 pytestmark = pytest.mark.slow  # a recorded episode, ingested whole several times
 
 T = BagTopics()
-SHORT_S = 1.0
-"""The broken bags keep the first second (10 frames) of the recording."""
+SHORT_S = 3.0
+"""The broken bags keep the first three seconds (30 frames: the start's full turn, head looks included) of the recording."""
 
 
 def _drop(topic_to_drop: str):

@@ -30,7 +30,7 @@ def test_the_bag_holds_the_contract_topics_one_message_per_frame(recorded):
     t = BagTopics()
     for topic in (t.depth, t.rgb, t.semantic, t.instance, t.camera_info, t.labels, "/tf", POSE_TOPIC):
         assert counts[topic] == recorded.frames > 50
-    assert counts["/tf_static"] == 1
+    assert "/tf_static" not in counts  # the head moves: base -> camera travels on /tf with every frame
     assert types[t.depth] == "sensor_msgs/msg/Image" and types[t.labels] == "std_msgs/msg/String"
 
 
