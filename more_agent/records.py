@@ -312,14 +312,19 @@ class EpisodeRecord(BaseModel):
             scene=spec.scene or "",
             seed=spec.seed,
             planner=spec.planner,
-            llm=spec.llm,
-            start=spec.start,
-            distractors=spec.distractors,
-            descriptions=spec.descriptions,
-            history=spec.history,
-            perception=spec.perception,
+            **episode_settings(spec),
             **fields,
         )
+
+
+EPISODE_SETTINGS = ("llm", "start", "distractors", "descriptions", "history", "perception")
+"""The settings an episode shares with its run beside (task, scene, seed, planner): the one list that
+specs, records and folder names copy from each other, so a new setting is added here once."""
+
+
+def episode_settings(source: object) -> dict[str, Any]:
+    """:data:`EPISODE_SETTINGS` read from ``source`` (a spec, record or run config)."""
+    return {name: getattr(source, name) for name in EPISODE_SETTINGS}
 
 
 class EpisodeSpec(FrozenModel):

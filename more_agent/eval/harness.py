@@ -38,7 +38,7 @@ from more_agent.eval.store import (
 from more_agent.eval.worker import error_record, execute_episode, resolve_episode_fn
 from more_agent.interrupts import ignore_interrupts, interrupted
 from more_agent.llm.concurrency import LLMConcurrencyLimiter, ProcessLimiter, set_llm_limiter
-from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.records import EpisodeRecord, EpisodeSpec, episode_settings
 from more_agent.safe_files import read_bounded
 
 DEFAULT_EPISODE_FN = "more_agent.eval.episode:run_episode"
@@ -117,12 +117,7 @@ def config_specs(config: RunConfig) -> list[EpisodeSpec]:
             scene=config.scene,
             seed=s,
             planner=config.planner,
-            llm=config.llm,
-            start=config.start,
-            distractors=config.distractors,
-            descriptions=config.descriptions,
-            history=config.history,
-            perception=config.perception,
+            **episode_settings(config),
         )
         for t in config.tasks
         for s in config.seeds

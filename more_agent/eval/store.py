@@ -28,6 +28,7 @@ from more_agent.records import (
     EpisodeRecord,
     EpisodeSpec,
     HistoryMode,
+    episode_settings,
     legacy_history,
 )
 from more_agent.redaction import redact_tree
@@ -324,12 +325,7 @@ def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str 
         scene if scene is not None else episode.scene,
         episode.seed,
         episode.planner,
-        llm=episode.llm,
-        start=episode.start,
-        distractors=episode.distractors,
-        descriptions=episode.descriptions,
-        history=episode.history,
-        perception=episode.perception,
+        **episode_settings(episode),
     )
     return Path(run_dir) / EPISODE_DIRS / name
 
