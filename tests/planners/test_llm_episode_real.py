@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import jsonschema
 import pytest
 from typer.testing import CliRunner
 
@@ -36,7 +37,8 @@ KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 TASK = "putting_shopping_away"
 STEPS = 2
 """High-level steps per episode: enough for room labels, filter, plans and feedback, short on 2 cores."""
-ANSWERS = {json.dumps(json_schema_of(m), sort_keys=True): m for m in (RoomLabelAnswer, FilterAnswer, PlanAnswer)}
+ANSWERS = {json_schema_of(m)["title"]: m for m in (RoomLabelAnswer, FilterAnswer, PlanAnswer)}
+"""Answer models by schema title: requests may carry per-request name enums (``llm/name_enums.py``)."""
 runner = CliRunner()
 
 
@@ -71,7 +73,9 @@ def _record_check_replay(tmp_path: Path, llm: str, env: dict[str, str], monkeypa
     assert usage.calls == len(rows) + usage.cache_hits >= 2  # room label(s), filter, plan at the least
     tokenizer = LlamaCppBackend(bundled_model_path("smollm2"))
     for request, text, prompt_tokens, completion_tokens in rows:
-        ANSWERS[json.dumps(request["schema"], sort_keys=True)].model_validate_json(text)  # every answer parses
+        schema = request["schema"]
+        ANSWERS[schema["title"]].model_validate_json(text)  # every answer parses as its model
+        jsonschema.validate(json.loads(text), schema)  # and keeps to the schema sent, name enums included
         assert prompt_tokens == tokenizer.prompt_tokens(request["messages"]) and completion_tokens > 0
     assert usage.prompt_tokens >= sum(r[2] for r in rows) and usage.completion_tokens >= sum(r[3] for r in rows)
     assert usage.seconds > 0 and record.timings["llm"] == pytest.approx(usage.seconds, abs=1e-5)
