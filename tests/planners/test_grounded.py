@@ -2,21 +2,30 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from more_agent.eval.episode import reset_planner, run_episode
 from more_agent.planners.base import HighLevelAction, default_planner, make_planner
-from more_agent.planners.grounded import (
-    FLOOR,
+from more_agent.planners.grounded import GroundedPlanner
+from more_agent.planners.grounded.agenda import Agenda
+from more_agent.planners.grounded.belief import GROUND_M, Belief, StepOutcome, bind, learn_from_outcome, on_floor
+from more_agent.planners.grounded.choose import act_for, choose
+from more_agent.planners.grounded.literals import floor_region, holds
+from more_agent.planners.grounded.search import (
     FRUITLESS_EXPLORES,
-    GROUND_M,
     OPENS_BEFORE_EXPLORING,
-    GroundedPlanner,
-    _on_floor,
     far_frontiers,
+    informative,
+    is_furniture_scope,
+    room_to_explore,
+    search,
+    task_rooms,
 )
+from more_agent.planners.grounded.situation import Situation
+from more_agent.planners.grounded.steps import put_down
 from more_agent.planners.room_types import is_furniture, likely_room_type
 from more_agent.planners.targets import Area
 from more_agent.records import EpisodeSpec, FailureReason
@@ -28,6 +37,7 @@ from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in
 from more_agent.sim.scene import load_scene
 from more_agent.sim.task_goal import intended_goal, task_goal
 from more_agent.sim.world import World
+from more_agent.vocabulary import FLOOR
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -52,6 +62,39 @@ def planner_in(kitchen: TaskInstance) -> GroundedPlanner:
     return planner
 
 
+def state(planner: GroundedPlanner) -> tuple[Belief, Situation, Agenda]:
+    """What the planner's choice is a function of: its belief, the step's situation, the goal's agenda."""
+    assert planner.agenda is not None
+    return planner.belief, planner.situation(), planner.agenda
+
+
+def with_goal(agenda: Agenda, **changes: object) -> Agenda:
+    """``agenda`` with its goal changed (``TaskGoal`` fields)."""
+    return replace(agenda, goal=replace(agenda.goal, **changes))  # type: ignore[arg-type]
+
+
+def a_moved_item(belief: Belief, sit: Situation, agenda: Agenda) -> tuple[str, str]:
+    """A scope the goal moves that binds to an observed instance, and that instance's label."""
+    goal = agenda.goal
+    scope = next(s for s in sorted(goal.moved) if bind(belief, goal, s, sit.xy) is not None)
+    return scope, belief.bound[scope]
+
+
+def with_far_room(sit: Situation) -> tuple[Situation, str]:
+    """``sit`` with an unexplored region far from the kitchen added to its graph; and the region's id."""
+    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
+    graph = sit.graph.model_copy(update={"regions": {**sit.graph.regions, other.id: other}})
+    return replace(sit, graph=graph, names={**sit.names, other.id: "garden_0"}), other.id
+
+
+def learn(
+    belief: Belief, agenda: Agenda, sit: Situation, action: HighLevelAction, result: ActionResult, news: bool = False
+) -> None:
+    """Let the belief learn from ``action`` ending in ``result`` where the robot stands."""
+    outcome = StepOutcome(result, held=None, region=sit.here, news=news, path_length=len(sit.path))
+    learn_from_outcome(belief, agenda.goal, action, outcome)
+
+
 @pytest.fixture(scope="module")
 def kitchen() -> TaskInstance:
     return fresh_kitchen()
@@ -71,7 +114,10 @@ def test_a_forall_whose_body_names_one_scope_is_read_over_its_variable() -> None
     the body: bddl checks one document no reader can tell apart, the reader puts all of them in the bin."""
     typo = [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01_1", "?bin.n.01_1"]]]
     assert intended_goal(typo) == [["forall", ["?x.n.01", "-", "x.n.01"], ["inside", "?x.n.01", "?bin.n.01_1"]]]
-    meant = [["forall", ["?x.n.01", "-", "x.n.01"], ["ontop", "?x.n.01", "?table.n.01_1"]], ["not", ["open", "?fridge.n.01_1"]]]
+    meant = [
+        ["forall", ["?x.n.01", "-", "x.n.01"], ["ontop", "?x.n.01", "?table.n.01_1"]],
+        ["not", ["open", "?fridge.n.01_1"]],
+    ]
     assert intended_goal(meant) == meant
     papers = instantiate("recycling_office_papers", None, 1, start="task-room", distractors=False)
     goal = task_goal(papers, GoalChecker(papers))
@@ -91,7 +137,9 @@ def test_grounded_solves_the_kitchen_task_without_checking_the_goal(kitchen: Tas
         if action.is_done:
             break
     assert actions[-1][0] == "done" and GoalChecker(kitchen).check(kitchen.world).all_met, actions
-    assert all(name != "go_to_and_place_inside" or ok for name, _, ok in actions)  # never places into a closed container
+    assert all(
+        name != "go_to_and_place_inside" or ok for name, _, ok in actions
+    )  # never places into a closed container
 
 
 @pytest.mark.slow
@@ -127,18 +175,15 @@ def test_explore_goes_to_the_frontiers_with_the_most_unseen_floor_in_range() -> 
     from more_agent.mapping import FREE, UNKNOWN
     from more_agent.scene_graph import OccupancyMap
 
-    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)  # untouched by other tests
-    planner = GroundedPlanner()
-    reset_planner(planner, kitchen, BlindGoals(kitchen))
-    planner.observe()
+    sit = planner_in(fresh_kitchen()).situation()
     cells = np.full((400, 200), FREE, dtype=np.int8)  # 40 m x 20 m at 0.1 m, corner at the origin
     cells[300:, :] = UNKNOWN  # a large unseen area east of x = 30 m
     cells[:20, 95:105] = UNKNOWN  # a nook at the west edge, nearly seen
     occupancy = OccupancyMap(grid=cells, origin_xy=(0.0, 0.0), resolution_m=0.1)
-    planner.graph = planner._graph().model_copy(update={"occupancy": occupancy})
+    sit = replace(sit, graph=sit.graph.model_copy(update={"occupancy": occupancy}))
     nook, open_edge, beside = (2.1, 10.0), (29.9, 10.0), (29.9, 2.0)
-    assert planner._informative((nook, open_edge, beside)) == (open_edge, beside)
-    assert planner._informative((nook,)) == (nook,)  # a single frontier is kept whatever it shows
+    assert informative(sit, (nook, open_edge, beside)) == (open_edge, beside)
+    assert informative(sit, (nook,)) == (nook,)  # a single frontier is kept whatever it shows
 
 
 def test_unlisted_categories_do_not_rank_rooms() -> None:
@@ -147,16 +192,24 @@ def test_unlisted_categories_do_not_rank_rooms() -> None:
 
 def test_a_room_whose_last_explores_revealed_nothing_yields_to_opening() -> None:
     planner = planner_in(fresh_kitchen())
-    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
-    lit = planner.literals[0]
-    step = planner._search(lit, None)
-    area = step.action.target
-    assert step.action.name == "explore" and isinstance(area, Area) and area.frontiers and area.region_id
-    planner.fruitless[area.region_id] = FRUITLESS_EXPLORES - 1
-    assert planner._search(lit, None).action.name == "explore"  # one explore without news is not enough
-    planner.fruitless[area.region_id] = FRUITLESS_EXPLORES  # its last explores showed nothing new
-    planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
-    assert planner._search(lit, None).action.name == "go_to_and_open"
+    belief, sit, agenda = state(planner)
+    belief.opened_in_a_row = OPENS_BEFORE_EXPLORING  # containers of the room had their turn
+    lit = agenda.literals[0]
+    explore = search(belief, sit, agenda, lit, None).action
+    area = explore.target
+    assert explore.name == "explore" and isinstance(area, Area) and area.frontiers and area.region_id
+    for _ in range(FRUITLESS_EXPLORES - 1):
+        learn(belief, agenda, sit, explore, ActionResult(ok=True, reason=None, feedback=""))
+    assert search(belief, sit, agenda, lit, None).action.name == "explore"  # one explore without news is not enough
+    learn(
+        belief, agenda, sit, explore, ActionResult(ok=True, reason=None, feedback="")
+    )  # its last explores showed nothing new
+    belief.looked_at.update(belief.seen)  # and its furniture was seen from close by
+    assert search(belief, sit, agenda, lit, None).action.name == "go_to_and_open"
+    learn(
+        belief, agenda, sit, explore, ActionResult(ok=True, reason=None, feedback=""), news=True
+    )  # an explore with news: explore on
+    assert search(belief, sit, agenda, lit, None).action.name == "explore"
 
 
 def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
@@ -170,77 +223,70 @@ def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
 
 
 def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
-    planner = GroundedPlanner()
-    reset_planner(planner, kitchen, BlindGoals(kitchen))
-    planner.observe()
-    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
-    label = planner.bound[scope]
-    grasp = HighLevelAction("go_to_and_grasp", ("kitchen_0", label), planner.seen[label])
-    hand = ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full")
-    planner._failed(grasp, label, hand)
-    assert planner.bound[scope] == label  # one failure of another kind: tried again
+    belief, sit, agenda = state(planner_in(kitchen))
+    scope, label = a_moved_item(belief, sit, agenda)
+    grasp = HighLevelAction("go_to_and_grasp", ("kitchen_0", label), belief.seen[label])
+    learn(belief, agenda, sit, grasp, ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full"))
+    assert belief.bound[scope] == label  # one failure of another kind: tried again
     refused = ActionResult(ok=False, reason=FailureReason.NOT_GRASPABLE, feedback=f"{label} cannot be picked up")
-    planner._failed(grasp, label, refused)  # as if it were furniture
-    assert scope not in planner.bound and label in planner.dropped and planner._label(scope) != label
+    learn(belief, agenda, sit, grasp, refused)  # as if it were furniture
+    assert scope not in belief.bound and label in belief.dropped and bind(belief, agenda.goal, scope, sit.xy) != label
 
 
 def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
-    planner = GroundedPlanner()
-    reset_planner(planner, kitchen, BlindGoals(kitchen))
-    planner.observe()
-    fridge = planner.seen["fridge A"]
-    assert fridge.bbox.min[2] <= GROUND_M and _on_floor(planner.relation["fridge A"])  # it stands on the floor
-    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
-    item = planner.bound[scope]
-    assert not _on_floor(planner.relation[item])  # on a counter or inside a cabinet
-    floor = next(iter(planner.goal.floor_rooms))
-    assert planner._put_down(item).action.arguments[1] == FLOOR
-    planner.literals = [Literal("ontop", (scope, floor), negated=True)]
-    planner.relation[item] = ("ontop", f"{FLOOR} kitchen")
-    assert planner._holds(planner.literals[0]) is False
-    support = planner._put_down(item)
-    target = support.action.target
+    belief, sit, agenda = state(planner_in(kitchen))
+    fridge = belief.seen["fridge A"]
+    assert fridge.bbox.min[2] <= GROUND_M and on_floor(belief.relation["fridge A"])  # it stands on the floor
+    scope, item = a_moved_item(belief, sit, agenda)
+    assert not on_floor(belief.relation[item])  # on a counter or inside a cabinet
+    floor = next(iter(agenda.goal.floor_rooms))
+    assert put_down(belief, sit, agenda, item).action.arguments[1] == FLOOR
+    off = replace(agenda, literals=(Literal("ontop", (scope, floor), negated=True),))
+    belief.relation[item] = ("ontop", f"{FLOOR} kitchen")
+    assert holds(belief, sit, off, off.literals[0]) is False
+    target = put_down(belief, sit, off, item).action.target
     assert isinstance(target, ObjectNode) and target.label != item and is_furniture(target.category)
 
 
 def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
     """A floor literal holds for an object the scene graph shows on nothing: the planner does not pick it
     up to put it down again (cleaning_up_branches_and_twigs: the trash can already stands on the lawn)."""
-    planner = planner_in(fresh_kitchen())
-    floor = next(iter(planner.goal.floor_rooms))
-    planner.bound["bag"] = "paper_bag A"  # stands on the floor; the yogurt is inside it
-    planner.bound["yogurt"] = "cup_of_yogurt A"
-    assert planner._holds(Literal("ontop", ("bag", floor))) is True
-    assert planner._holds(Literal("ontop", ("yogurt", floor))) is False
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    floor = next(iter(agenda.goal.floor_rooms))
+    belief.bound["bag"] = "paper_bag A"  # stands on the floor; the yogurt is inside it
+    belief.bound["yogurt"] = "cup_of_yogurt A"
+    assert holds(belief, sit, agenda, Literal("ontop", ("bag", floor))) is True
+    assert holds(belief, sit, agenda, Literal("ontop", ("yogurt", floor))) is False
 
 
 def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> None:
     """Explores clear a store's floor, but items on a far shelf show only from close by: once the room of
     the task's objects yields nothing new, the robot drives to its furniture it has not been near."""
     planner = planner_in(fresh_kitchen())
-    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"  # a task object: its room is a task room
-    room = planner.seen["cup_of_yogurt A"].region_id
-    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING
-    planner.fruitless[room] = FRUITLESS_EXPLORES
-    step = planner._search(planner.literals[0], None)
-    assert step.action.name == "navigate" and isinstance(step.action.target, ObjectNode)
-    assert step.action.target.region_id == room
-    planner.execute(step.action)
-    assert planner._search(planner.literals[0], None).action.target != step.action.target  # each piece once
+    belief, sit, agenda = state(planner)
+    assert bind(belief, agenda.goal, "cup__of__yogurt.n.01_1", sit.xy) == "cup_of_yogurt A"  # its room is a task room
+    room = belief.seen["cup_of_yogurt A"].region_id
+    belief.opened_in_a_row = OPENS_BEFORE_EXPLORING
+    belief.fruitless[room] = FRUITLESS_EXPLORES
+    step = search(belief, sit, agenda, agenda.literals[0], None).action
+    assert step.name == "navigate" and isinstance(step.target, ObjectNode)
+    assert step.target.region_id == room
+    planner.execute(step)
+    later = search(belief, planner.situation(), agenda, agenda.literals[0], None).action
+    assert later.target != step.target  # each piece once
 
 
 def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:
     """A task's objects are set out together: the room where some were found is searched on before a
     room not explored yet (buying_groceries left the store for a bathroom with groceries unseen)."""
-    planner = planner_in(fresh_kitchen())
-    graph = planner._graph()
-    room = graph.robot.region_id
-    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
-    planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
-    planner.explored[room], planner.fruitless[room] = 5, 1  # explored often, the last one without news
-    assert planner._room_to_explore([], planner._task_rooms()) == other.id  # nothing of the task found yet: the fresh room
-    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
-    assert planner._room_to_explore([], planner._task_rooms()) == room
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    room = sit.here
+    assert room is not None
+    belief.explored[room], belief.fruitless[room] = 5, 1  # explored often, the last one without news
+    assert room_to_explore(belief, sit, agenda, [], task_rooms(belief, agenda)) == far  # nothing of the task found yet
+    assert bind(belief, agenda.goal, "cup__of__yogurt.n.01_1", sit.xy) == "cup_of_yogurt A"
+    assert room_to_explore(belief, sit, agenda, [], task_rooms(belief, agenda)) == room
 
 
 def test_when_only_closing_is_left_the_planner_closes() -> None:
@@ -249,41 +295,34 @@ def test_when_only_closing_is_left_the_planner_closes() -> None:
     kitchen = fresh_kitchen()
     for scope in ("electric_refrigerator.n.01_1", "cabinet.n.01_1"):
         kitchen.world.set_open(kitchen.scope[scope], True)
-    planner = planner_in(kitchen)
-    planner.literals = [Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True)]
-    assert planner.decide().name == "go_to_and_close"
+    belief, sit, agenda = state(planner_in(kitchen))
+    closing = (Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True))
+    assert choose(belief, sit, replace(agenda, literals=closing)).action.name == "go_to_and_close"
 
 
 def test_an_object_that_must_leave_the_floor_is_not_picked_up_to_be_put_down_again() -> None:
     """(not (ontop sod lawn)) is met by the placement elsewhere the goal asks for; putting the sod down
     where the robot stands never meets it (remove_sod looped on grasp and put down)."""
-    planner = planner_in(fresh_kitchen())
-    floor = next(iter(planner.goal.floor_rooms))
-    planner.bound["bag"], planner.bound["counter"] = "paper_bag A", "countertop A"
-    planner.literals = [Literal("ontop", ("bag", floor), True), Literal("ontop", ("bag", "counter"))]
-    assert planner._act_for(planner.literals[0], None) is None
-
-
-def with_far_room(planner: GroundedPlanner) -> str:
-    """Add an unexplored region far from the kitchen to the planner's graph; its id."""
-    graph = planner._graph()
-    other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
-    planner.graph = graph.model_copy(update={"regions": {**graph.regions, other.id: other}})
-    planner.names[other.id] = "garden_0"
-    return other.id
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    floor = next(iter(agenda.goal.floor_rooms))
+    belief.bound["bag"], belief.bound["counter"] = "paper_bag A", "countertop A"
+    sod = replace(agenda, literals=(Literal("ontop", ("bag", floor), True), Literal("ontop", ("bag", "counter"))))
+    assert act_for(belief, sit, sod, sod.literals[0], None) is None
 
 
 def test_missing_furniture_is_not_looked_for_in_containers() -> None:
     """A breakfast table is in no cabinet: when only furniture is missing the search opens nothing
     (putting_out_condiments seed 1 opened twenty kitchen cabinets for one). The kitchen has no bed."""
-    planner = planner_in(fresh_kitchen())
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
     table = "bed.n.01_1"
-    planner.goal.categories[table] = frozenset({"bed"})
-    unseen = next(lit.args[0] for lit in planner.literals if planner._label(lit.args[0]) is None)
-    assert planner._is_furniture_scope(table) and not planner._is_furniture_scope(unseen)
-    item = planner._search(Literal("ontop", (unseen, table)), None)
+    agenda = with_goal(agenda, categories={**agenda.goal.categories, table: frozenset({"bed"})})
+    unseen = next(lit.args[0] for lit in agenda.literals if bind(belief, agenda.goal, lit.args[0], sit.xy) is None)
+    assert is_furniture_scope(agenda, table) and not is_furniture_scope(agenda, unseen)
+    item = search(belief, sit, agenda, Literal("ontop", (unseen, table)), None)
     assert item.action.name == "go_to_and_open"  # an item may be in the closed cabinets of the room
-    step = planner._search(Literal("ontop", ("cup__of__yogurt.n.01_1", table)), None)  # the yogurt is in view
+    step = search(
+        belief, sit, agenda, Literal("ontop", ("cup__of__yogurt.n.01_1", table)), None
+    )  # the yogurt is in view
     assert step.action.name == "explore"
 
 
@@ -291,32 +330,47 @@ def test_task_rooms_are_where_the_items_were_found_and_their_containers_are_open
     """Items put in another room leave the room they were found in a task room: the other items are
     likeliest there (the peanut butter of putting_out_condiments in a kitchen cabinet, after the
     vinegar went to a table three rooms away)."""
-    planner = planner_in(fresh_kitchen())
-    far = with_far_room(planner)
-    assert planner._label("cup__of__yogurt.n.01_1") == "cup_of_yogurt A"
-    kitchen_room = planner.seen["cup_of_yogurt A"].region_id
-    planner.seen["cup_of_yogurt A"] = planner.seen["cup_of_yogurt A"].model_copy(update={"region_id": far})
-    assert planner._task_rooms() == {kitchen_room}  # found there, whatever room it was carried to
-    planner.fruitless[kitchen_room] = FRUITLESS_EXPLORES  # the kitchen's explores show nothing new
-    planner.looked_at.update(planner.seen)  # and its furniture was seen from close by
-    planner.opened_in_a_row = OPENS_BEFORE_EXPLORING  # the room's containers had their turn in a row
-    lit = next(lit for lit in planner.literals if planner._label(lit.args[0]) is None)
-    step = planner._search(lit, None)
-    assert step.action.name == "go_to_and_open" and isinstance(step.action.target, ObjectNode)
-    assert step.action.target.region_id == kitchen_room
-    planner.looked_into.update(planner.seen)  # every container of the kitchen looked into
-    later = planner._search(lit, None).action.target
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    yogurt = "cup_of_yogurt A"
+    assert bind(belief, agenda.goal, "cup__of__yogurt.n.01_1", sit.xy) == yogurt
+    kitchen_room = belief.seen[yogurt].region_id
+    belief.seen[yogurt] = belief.seen[yogurt].model_copy(update={"region_id": far})
+    assert task_rooms(belief, agenda) == {kitchen_room}  # found there, whatever room it was carried to
+    belief.fruitless[kitchen_room or ""] = FRUITLESS_EXPLORES  # the kitchen's explores show nothing new
+    belief.looked_at.update(belief.seen)  # and its furniture was seen from close by
+    belief.opened_in_a_row = OPENS_BEFORE_EXPLORING  # the room's containers had their turn in a row
+    lit = next(lit for lit in agenda.literals if bind(belief, agenda.goal, lit.args[0], sit.xy) is None)
+    step = search(belief, sit, agenda, lit, None).action
+    assert step.name == "go_to_and_open" and isinstance(step.target, ObjectNode)
+    assert step.target.region_id == kitchen_room
+    belief.looked_into.update(belief.seen)  # every container of the kitchen looked into
+    later = search(belief, sit, agenda, lit, None).action.target
     assert isinstance(later, Area) and later.region_id == far  # now the search moves on
 
 
 def test_an_item_is_not_picked_up_for_a_floor_whose_room_is_not_found_yet() -> None:
-    """"on top of the garden floor" from a house: the planner searches for the garden first; before, it
+    """ "on top of the garden floor" from a house: the planner searches for the garden first; before, it
     picked the bag up, found no garden to put it in, put it down again, and so on for 50 steps."""
-    planner = planner_in(fresh_kitchen())
-    scope = next(s for s in sorted(planner.goal.moved) if planner._label(s) is not None)
-    floor = next(iter(planner.goal.floor_rooms))
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    scope, _ = a_moved_item(belief, sit, agenda)
+    floor = next(iter(agenda.goal.floor_rooms))
     lit = Literal("ontop", (scope, floor))
-    planner.goal.floor_rooms[floor] = "garden"
-    assert planner._floor_region(floor) is None and planner._act_for(lit, None) is None
-    planner.goal.floor_rooms[floor] = None  # any floor will do: the one the robot stands on
-    assert planner._act_for(lit, None).action.name == "go_to_and_grasp"
+    garden = with_goal(agenda, floor_rooms={**agenda.goal.floor_rooms, floor: "garden"})
+    assert floor_region(belief, sit, garden, floor) is None and act_for(belief, sit, garden, lit, None) is None
+    anywhere = with_goal(agenda, floor_rooms={**agenda.goal.floor_rooms, floor: None})  # the floor the robot stands on
+    grasp = act_for(belief, sit, anywhere, lit, None)
+    assert grasp is not None and grasp.action.name == "go_to_and_grasp"
+
+
+def test_opening_to_look_is_counted_in_a_row_and_reset_by_any_other_step() -> None:
+    """The planner's decide counts containers opened to look inside one after the other (the search
+    explores again after ``OPENS_BEFORE_EXPLORING``); another step starts the count again."""
+    planner = planner_in(fresh_kitchen())
+    belief, sit, agenda = state(planner)
+    lit = next(lit for lit in agenda.literals if bind(belief, agenda.goal, lit.args[0], sit.xy) is None)
+    planner.agenda = replace(agenda, literals=(lit,))  # only an unseen item left to act for
+    step = planner.decide()
+    assert step.name == "go_to_and_open" and belief.opened_in_a_row == 1  # the kitchen's closed containers first
+    belief.opened_in_a_row = OPENS_BEFORE_EXPLORING
+    assert planner.decide().name == "explore" and belief.opened_in_a_row == 0

@@ -1,0 +1,50 @@
+"""Whether a goal literal holds as far as the ``grounded`` planner knows."""
+
+from __future__ import annotations
+
+from more_agent.goal import Literal
+from more_agent.planners.grounded.agenda import Agenda
+from more_agent.planners.grounded.belief import Belief, bind, on_floor
+from more_agent.planners.grounded.situation import Situation
+from more_agent.vocabulary import FLOOR
+
+
+def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool | None:
+    """Whether ``lit`` holds on the observed open states and relations and the planner's own placements;
+    None while one of its objects is unseen (binding its scopes when it can)."""
+    goal = agenda.goal
+    if lit.predicate == "open":
+        label = bind(belief, goal, lit.args[0], sit.xy)
+        if label is None:
+            return None
+        return bool(belief.seen[label].open) != lit.negated
+    subject, target = lit.args
+    if subject == goal.robot:
+        region = floor_region(belief, sit, agenda, target)
+        return None if region is None else (sit.here == region) != lit.negated
+    a = bind(belief, goal, subject, sit.xy)
+    if a is None:
+        return None
+    rel = belief.relation.get(a)
+    if goal.is_floor(target):
+        want = goal.floor_rooms.get(target)
+        on = rel is not None and on_floor(rel) and (want is None or rel[1] == f"{FLOOR} {want}")
+        return on != lit.negated
+    b = bind(belief, goal, target, sit.xy)
+    if b is None:
+        return None
+    return (rel == (lit.predicate, b)) != lit.negated
+
+
+def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> str | None:
+    """A reachable region whose room type is the floor's (the robot's when the description names none)."""
+    want = agenda.goal.floor_rooms.get(scope)
+    if want is None:
+        return sit.here
+    matches = sorted(rid for rid, kind in belief.room_types.items() if kind == want)
+    return matches[0] if matches else None
+
+
+def closes(lit: Literal) -> bool:
+    """Whether ``lit`` asks for something closed."""
+    return lit.predicate == "open" and lit.negated

@@ -1,0 +1,219 @@
+"""How the ``grounded`` planner looks for an object it has not seen (package docstring, point 4)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from more_agent.goal import Literal
+from more_agent.mapping import visible_unknown_area
+from more_agent.planners.base import DONE, HighLevelAction
+from more_agent.planners.grounded.agenda import Agenda
+from more_agent.planners.grounded.belief import Belief, bind
+from more_agent.planners.grounded.situation import Situation
+from more_agent.planners.grounded.steps import Choice, object_step, put_down
+from more_agent.planners.room_types import category_likelihood, is_furniture
+from more_agent.planners.targets import Area
+from more_agent.robot import XY
+from more_agent.scene_graph import ObjectNode
+from more_agent.sim.catalog import can_hold_things, is_surface
+
+OPENS_BEFORE_EXPLORING = 3
+"""Containers opened to look inside, one after the other, before the search explores again."""
+
+FRUITLESS_EXPLORES = 2
+"""A room whose last explores, this many in a row, revealed no new object yields to containers, doors, other rooms."""
+
+FAR_FRONTIER_SHARE = 0.5
+"""Explore goes to the frontiers at least this share as far from the robot's path as the farthest one."""
+
+INFORMATIVE_SHARE = 0.75
+"""... and of those, to the ones showing at least this share of the most unknown floor in sensor range."""
+
+LOOK_AT_M = 2.0
+"""Furniture of the task's rooms with a corner farther than this from everywhere the robot has been is
+driven to when an item is missing."""
+
+
+def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: str | None) -> Choice:
+    """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
+    containers, closed doors; give up when none is left."""
+    goal = agenda.goal
+    missing = [
+        s for s in lit.args if s != goal.robot and not goal.is_floor(s) and bind(belief, goal, s, sit.xy) is None
+    ]
+    note = f"looking for {', '.join(goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
+    items = not missing or any(not is_furniture_scope(agenda, s) for s in missing)
+    closed = closed_containers(belief, sit) if items else []
+    rooms = task_rooms(belief, agenda)
+    region = room_to_explore(belief, sit, agenda, missing, rooms)
+    if (
+        closed
+        and closed[0].region_id == sit.here
+        and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
+    ):
+        return open_to_look(belief, sit, agenda, closed[0].label, held, note)
+    if items and (region is None or stale(belief, region) or region not in rooms):
+        furniture = furniture_to_look_at(belief, sit, rooms)
+        if furniture is not None:
+            return object_step(sit, "navigate", furniture, note)
+        in_task_rooms = [o for o in closed if o.region_id in rooms]
+        if in_task_rooms:
+            return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
+    if region is not None and not stale(belief, region):
+        return explore_step(sit, region, note)
+    if closed:
+        return open_to_look(belief, sit, agenda, closed[0].label, held, note)
+    doors = closed_doors(belief, sit)
+    if doors:
+        return open_to_look(belief, sit, agenda, doors[0].label, held, note)
+    if region is not None:
+        return explore_step(sit, region, note)
+    why = f"{note}: nothing left to explore or open"
+    return Choice(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+
+
+def closed_containers(belief: Belief, sit: Situation) -> list[ObjectNode]:
+    """Closed containers that hold things, not looked into nor given up: the robot's room's first, nearest first."""
+    here = sit.here
+    return sorted(
+        (
+            o
+            for o in sit.graph.objects.values()
+            if o.open is False
+            and can_hold_things(o.category)
+            and o.label not in belief.looked_into
+            and o.label not in belief.dropped
+        ),
+        key=lambda o: (o.region_id != here, math.dist(o.position[:2], sit.xy), o.label),
+    )
+
+
+def closed_doors(belief: Belief, sit: Situation) -> list[ObjectNode]:
+    """Closed doors not given up, nearest first."""
+    return sorted(
+        (
+            o
+            for o in sit.graph.objects.values()
+            if o.category == "door" and o.open is False and o.label not in belief.dropped
+        ),
+        key=lambda o: math.dist(o.position[:2], sit.xy),
+    )
+
+
+def is_furniture_scope(agenda: Agenda, scope: str) -> bool:
+    """Whether ``scope`` is furniture: the goal does not move it and every category that counts as it
+    is furniture. A missing table is in no cabinet and shows from afar, so the search neither opens
+    containers nor drives along shelves for it."""
+    cats = agenda.goal.categories.get(scope, frozenset())
+    return scope not in agenda.goal.moved and bool(cats) and all(is_furniture(c) for c in cats)
+
+
+def furniture_to_look_at(belief: Belief, sit: Situation, rooms: set[str]) -> str | None:
+    """The nearest furniture things are put on (tables, shelves, counters: ``sim.catalog.is_surface``)
+    of the task's ``rooms`` the robot has not been near (``LOOK_AT_M``): explore() clears a store's
+    floor, but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
+    if belief.fruitless_looks >= FRUITLESS_EXPLORES:
+        return None
+    candidates = [
+        o
+        for o in sit.graph.objects.values()
+        if o.region_id in rooms
+        and o.open is None
+        and is_surface(o.category)
+        and o.label not in belief.looked_at
+        and o.label not in belief.dropped
+        and _far_corner_gap(o, sit.path) > LOOK_AT_M
+    ]
+    return min(candidates, key=lambda o: (math.dist(o.position[:2], sit.xy), o.label)).label if candidates else None
+
+
+def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, held: str | None, note: str) -> Choice:
+    """Open ``label`` to look inside (freeing the hand first)."""
+    if held is not None:
+        return put_down(belief, sit, agenda, held)
+    return Choice(object_step(sit, "go_to_and_open", label, note).action, looking=True)
+
+
+def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: list[str], rooms: set[str]) -> str | None:
+    """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
+    new last; then the room most likely to hold the missing furniture; then the rooms of the task's
+    items found so far (``rooms``, from :func:`task_rooms`); then a room whose explores still reveal new
+    objects before one not explored yet (a garden or a store is searched through, not left after a few
+    metres); then the least explored, the nearest."""
+    cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
+
+    def score(rid: str) -> tuple[bool, float, bool, bool, int, float, str]:
+        kind = belief.room_types.get(rid)
+        like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
+        productive = belief.explored[rid] > 0 and belief.fruitless[rid] == 0
+        return (
+            stale(belief, rid),
+            -like,
+            rid not in rooms,
+            not productive,
+            belief.explored[rid],
+            math.dist(sit.graph.regions[rid].centroid, sit.xy),
+            rid,
+        )
+
+    open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
+    return min(open_regions, key=score) if open_regions else None
+
+
+def task_rooms(belief: Belief, agenda: Agenda) -> set[str]:
+    """Regions where the objects the goal moves were found (not where the robot put them): a task's
+    items are set out together (a store's groceries, a kitchen's food), so its other items are
+    likeliest there. Furniture a goal only names as a target (any cabinet the plates may go in)
+    tells nothing of where they are."""
+    moved = {lit.args[0] for lit in agenda.literals if lit.predicate != "open"}
+    found = {belief.found_in[belief.bound[s]] for s in moved if s in belief.bound}
+    return {rid for rid in found if rid is not None}
+
+
+def stale(belief: Belief, region: str) -> bool:
+    """Whether the region's last explores revealed no object not seen before."""
+    return belief.fruitless[region] >= FRUITLESS_EXPLORES
+
+
+def explore_step(sit: Situation, region: str, note: str) -> Choice:
+    """Explore ``region`` towards its far frontiers that show the most unseen floor."""
+    far = far_frontiers(sit.graph.frontiers(region), sit.path)
+    room = sit.names[region]
+    return Choice(HighLevelAction("explore", (room,), Area(room, region, informative(sit, far)), note=note))
+
+
+def informative(sit: Situation, frontiers: tuple[XY, ...]) -> tuple[XY, ...]:
+    """The frontiers from which the most unknown floor lies in sensor range (``INFORMATIVE_SHARE``):
+    a frontier at the edge of a large unseen area before one beside a corner nearly seen."""
+    occupancy = sit.graph.occupancy
+    if occupancy is None or len(frontiers) < 2:
+        return frontiers
+    gain = visible_unknown_area(occupancy.grid, occupancy.frame, np.asarray(frontiers), range_m=sit.sensor_range_m)
+    return tuple(f for f, g in zip(frontiers, gain) if g >= INFORMATIVE_SHARE * gain.max())
+
+
+def far_frontiers(frontiers: Sequence[XY], path: Sequence[XY]) -> tuple[XY, ...]:
+    """The frontiers far from everywhere the robot has been (``FAR_FRONTIER_SHARE``): explore() drives
+    to the nearest of them, so a garden or a store is crossed instead of covered a few metres at a time."""
+    if not frontiers:
+        return ()
+    gap = _gap_to_path(np.asarray(frontiers, dtype=float), path)
+    return tuple(f for f, d in zip(frontiers, gap) if d >= FAR_FRONTIER_SHARE * gap.max())
+
+
+def _far_corner_gap(obj: ObjectNode, path: Sequence[XY]) -> float:
+    """How far the corner of ``obj``'s footprint farthest from the robot's path is from it: a long shelf
+    passed at one end still has its other end to show."""
+    (x0, y0), (x1, y1) = obj.bbox.min[:2], obj.bbox.max[:2]
+    corners = np.array([(x0, y0), (x0, y1), (x1, y0), (x1, y1)], dtype=float)
+    return float(_gap_to_path(corners, path).max())
+
+
+def _gap_to_path(points: np.ndarray, path: Sequence[XY]) -> np.ndarray:
+    """Distance from each of ``points`` (n x 2) to the nearest point of the robot's path (every 4th
+    point, 0.3 m apart); infinite before the robot has moved."""
+    seen = np.asarray(path[::4] or [(math.inf, math.inf)], dtype=float)
+    return np.sqrt(((points[:, None, :] - seen[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
