@@ -3,8 +3,8 @@
 from more_agent.planners.base import (
     DONE,
     EpisodeContext,
-    HighLevelAction,
     Planner,
+    Step,
     default_planner,
     make_planner,
     planner_names,
@@ -14,8 +14,8 @@ from more_agent.planners.base import (
 __all__ = [
     "DONE",
     "EpisodeContext",
-    "HighLevelAction",
     "Planner",
+    "Step",
     "default_planner",
     "make_planner",
     "planner_names",

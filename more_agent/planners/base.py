@@ -1,6 +1,6 @@
 """The planner protocol the episode runner drives, and the registry of planners by name.
 
-One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``HighLevelAction``, or
+One high-level step is ``observe()`` (sense), ``decide()`` (plan: the next ``Step``, or
 ``done``) and ``execute(action)`` (act: run it through the robot, get an ``ActionResult``). A planner
 is given a :class:`~more_agent.robot.Robot` and a :class:`~more_agent.goal.GoalSpec` and nothing else
 of the episode (:class:`EpisodeContext`); only a privileged planner (the oracle) is also granted the
@@ -55,11 +55,11 @@ def default_planner(llm: str | None) -> str:
 
 
 @dataclass(frozen=True)
-class HighLevelAction:
-    """One planner decision, typed: a skill of the table (or a magic action of the oracle), its arguments
-    as words (room, object label: what the record and the LLM's history show) and what it acts on as a
-    typed target (``planners.targets``: an object node, an area, an unresolved name), which ``execute``
-    runs as it is."""
+class Step:
+    """One planner decision, typed: a skill of the table (or a magic action of the oracle) plus its typed
+    arguments: the arguments as words (room, object label: what the record and the LLM's history show)
+    and what the skill acts on as a typed target (``planners.targets``: an object node, an area, an
+    unresolved name), which ``execute`` runs as it is."""
 
     name: str
     arguments: tuple[str, ...] = ()
@@ -122,10 +122,10 @@ class Planner(Protocol):
     def observe(self) -> None:
         """Take in what the robot senses now (the sense phase; may do nothing)."""
 
-    def decide(self) -> HighLevelAction:
-        """The next high-level action (the plan phase)."""
+    def decide(self) -> Step:
+        """The next step (the plan phase)."""
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         """Carry out ``action`` in the world (the act phase); failures are results, not exceptions."""
 
     def step_trace(self) -> StepTrace:

@@ -52,7 +52,7 @@ from more_agent.llm.completion import ChatMessage
 from more_agent.llm.images import png_bytes
 from more_agent.llm.name_enums import constrains_names, with_name_enums
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace, needed
+from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.bumble_memory import (
     FailureStore,
     PastStep,
@@ -201,7 +201,7 @@ class BumblePlanner(MappingSession):
         self.descriptions = {i: o.text() for r in view.rooms for o in r.objects for i in o.ids}
         self.relevant = self._filter(view) if self.config.filtering else None
 
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         """Step decision, then the skill's parameter steps; ``invalid`` when an answer stays unusable."""
         try:
             schema = StepAnswer
@@ -209,16 +209,16 @@ class BumblePlanner(MappingSession):
                 schema = with_name_enums(StepAnswer, {"skill": [s.name for s in SKILLS]})
             skill, subtask = self._ask(self._step_messages(), schema, parse_step, "plan")
             if skill == DONE:
-                return HighLevelAction(name=DONE, note=subtask)
+                return Step(name=DONE, note=subtask)
             target = self._explore_target(subtask) if skill == "explore" else self._object_target(subtask)
         except InvalidAnswer as e:
-            return HighLevelAction(name=INVALID, note=e.reason)
+            return Step(name=INVALID, note=e.reason)
         arguments = (
             (target.label,) if isinstance(target, ObjectNode) else (target.name,) if isinstance(target, Area) else ()
         )
-        return HighLevelAction(name=skill, arguments=arguments, target=target, note=subtask)
+        return Step(name=skill, arguments=arguments, target=target, note=subtask)
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         """Run the subpolicy (explorations get the VLM's verdict as feedback)."""
         result = self._run(action)
         self.feedback = append_action(self.history, action, result)
@@ -226,7 +226,7 @@ class BumblePlanner(MappingSession):
         self._remember(action, self.history[-1])
         return result
 
-    def _remember(self, action: HighLevelAction, done: ActionRecord) -> None:
+    def _remember(self, action: Step, done: ActionRecord) -> None:
         """The step into the short-term memory; a failure also into the long-term memory file."""
         view = self.step_log.pictures.get("view")
         subtask = action.note if action.name != INVALID else ""
@@ -413,7 +413,7 @@ class BumblePlanner(MappingSession):
         ).value
 
     # -- acting ---------------------------------------------------------------------------------
-    def _run(self, action: HighLevelAction) -> ActionResult:
+    def _run(self, action: Step) -> ActionResult:
         """Dispatch one decided action to its subpolicy."""
         if action.name == INVALID:
             return ActionResult(

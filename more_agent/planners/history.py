@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
-from more_agent.planners.base import HighLevelAction
+from more_agent.planners.base import Step
 from more_agent.records import ActionRecord
 from more_agent.robot import ActionResult
 
 
-def append_action(history: list[ActionRecord], action: HighLevelAction, result: ActionResult) -> str:
+def append_action(history: list[ActionRecord], action: Step, result: ActionResult) -> str:
     """Append the executed ``action`` and its outcome to ``history``; returns the feedback line the
     next prompt shows (``skill: success|failure; reason``). The feedback is clipped: it reaches every
     later prompt through the history."""

@@ -52,7 +52,7 @@ from more_agent.llm import (
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
 from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, with_name_enums
 from more_agent.mapping import MappingConfig
-from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace, needed
+from more_agent.planners.base import EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.exchanges import CallLog, RecordingClient
 from more_agent.planners.history import append_action
 from more_agent.planners.language import LanguageOptions, SceneView, scene_view
@@ -178,7 +178,7 @@ class LLMPlanner(MappingSession):
         graph = self.graph = self._body().step_graph(self._classify_rooms)
         self.view = scene_view(graph, self.config.language)
 
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         """Filter (MORE) and plan: the next subpolicy call, or ``invalid`` when no valid answer came."""
         view = self._view()
         planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
@@ -195,16 +195,16 @@ class LLMPlanner(MappingSession):
                 purpose="plan",
             )
         except InvalidAnswer as e:
-            return HighLevelAction(name=INVALID, note=e.reason)
+            return Step(name=INVALID, note=e.reason)
         planned = answer.value
-        return HighLevelAction(
+        return Step(
             name=planned.skill,
             arguments=planned.arguments,
             target=self._target(planned.skill, planned.arguments),
             note=planned.reasoning,
         )
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         """Run the subpolicy; its outcome is the next prompt's feedback."""
         result = self._run(action)
         self.feedback = append_action(self.history, action, result)
@@ -274,7 +274,7 @@ class LLMPlanner(MappingSession):
         target = pick_target(graph, view.resolve(room, arguments[1]), skill, graph.robot.position)
         return target or Unresolved(FailureReason.UNKNOWN_OBJECT, f"unknown object {arguments[1]}")
 
-    def _run(self, action: HighLevelAction) -> ActionResult:
+    def _run(self, action: Step) -> ActionResult:
         """Run the decided skill on its target."""
         if action.name == INVALID:
             return ActionResult(

@@ -23,7 +23,7 @@ from collections import Counter
 from collections.abc import Collection
 
 from more_agent.goal import ROBOT_NAME, Literal
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace
 from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
 from more_agent.planners.policies import Embodiment
 from more_agent.records import FailureReason, LLMUsage
@@ -167,16 +167,16 @@ class OraclePlanner:
         return LLMUsage()
 
     # -- deciding -----------------------------------------------------------------------------
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         """``done`` when the goal holds (or nothing more can be done), else the next subpolicy."""
         if self._goals.check(self._world).all_met:
-            return HighLevelAction(DONE, note="all goal conditions hold")
+            return Step(DONE, note="all goal conditions hold")
         pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         while not pending:
             # bddl's ground options can be partly infeasible (e.g. '(ontop log_1 log_1)'): the next may finish the job.
             explanation = self._explain_unmet()
             if not self._adopt_next_option():
-                return HighLevelAction(DONE, gave_up=explanation)
+                return Step(DONE, gave_up=explanation)
             pending = [lit for lit in self._literals if not literal_holds(self._world, lit)]
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
@@ -185,7 +185,7 @@ class OraclePlanner:
             note = (
                 f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
             )
-            return HighLevelAction(DONE, gave_up=note)
+            return Step(DONE, gave_up=note)
         return action
 
     def _explain_unmet(self) -> str:
@@ -195,16 +195,16 @@ class OraclePlanner:
             )
         return "every literal of the chosen goal option holds, yet the goal check fails"
 
-    def _door_action(self) -> HighLevelAction | None:
+    def _door_action(self) -> Step | None:
         """Open the door reported as blocking, first freeing the hand."""
         if self._door is None or self._world.get(self._door).is_open:
             self._door = None
             return None
         if self._world.robot.held is not None:
             return self._put_down()
-        return HighLevelAction("go_to_and_open", (self._door,), note="a closed door blocks the way")
+        return Step("go_to_and_open", (self._door,), note="a closed door blocks the way")
 
-    def _next(self, pending: list[Literal]) -> HighLevelAction:
+    def _next(self, pending: list[Literal]) -> Step:
         held = self._world.robot.held
         if held is not None:
             # Finish what the hand holds: the placement it was grasped for first, else any that is ready.
@@ -215,7 +215,7 @@ class OraclePlanner:
                         return self._act(f"go_to_and_place_{lit.predicate}", lit.args[1], lit)
         return self._step_for(pending[0])
 
-    def _step_for(self, lit: Literal) -> HighLevelAction:
+    def _step_for(self, lit: Literal) -> Step:
         world, held = self._world, self._world.robot.held
         if lit.predicate == "open":
             target = lit.args[0]
@@ -249,10 +249,10 @@ class OraclePlanner:
             return self._act("go_to_and_open", door, lit)
         return self._fetch(subject, lit)
 
-    def _act(self, name: str, arg: str, lit: Literal) -> HighLevelAction:
-        return HighLevelAction(name, (arg,), note=f"for {lit.text}")
+    def _act(self, name: str, arg: str, lit: Literal) -> Step:
+        return Step(name, (arg,), note=f"for {lit.text}")
 
-    def _fetch(self, subject: str, lit: Literal) -> HighLevelAction:
+    def _fetch(self, subject: str, lit: Literal) -> Step:
         hider = self._world.enclosing_closed_container(subject)
         if hider is not None:
             return self._act("go_to_and_open", hider.name, lit)
@@ -277,7 +277,7 @@ class OraclePlanner:
             return None
         return blocking_door(self._world, start, goals)
 
-    def _put_down(self) -> HighLevelAction:
+    def _put_down(self) -> Step:
         """Free the hand: put the held item down where it breaks no goal and the robot can get to.
 
         In order: the floor of the robot's room, the top of the nearest furniture in that room, the
@@ -312,11 +312,11 @@ class OraclePlanner:
             ),
             key=rank,
         )
-        actions = [HighLevelAction("go_to_and_place_ontop", (o.name,), note="free the hand") for o in spots]
+        actions = [Step("go_to_and_place_ontop", (o.name,), note="free the hand") for o in spots]
         return next((a for a in actions if self._failures[(a.name, a.arguments)] == 0), actions[0])
 
     # -- acting -------------------------------------------------------------------------------
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         """Run a subpolicy as one magic action of the env; remember failures and blocking doors."""
         world = self._world
         result = self._body.act(world_action(action.name), *action.arguments)

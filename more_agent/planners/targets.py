@@ -1,4 +1,4 @@
-"""What a decided skill acts on, typed: the arguments of a :class:`~more_agent.planners.base.HighLevelAction`.
+"""What a decided skill acts on, typed: the arguments of a :class:`~more_agent.planners.base.Step`.
 
 A planner resolves the names it decided on (a room, an object label) when it decides, and hands the
 result to ``execute`` with the action: a scene-graph :class:`~more_agent.scene_graph.ObjectNode`, an

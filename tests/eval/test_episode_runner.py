@@ -10,7 +10,7 @@ from more_agent.eval.episode import MAX_HIGH_LEVEL_STEPS, STEPS_AFTER_GOAL, run_
 from more_agent.eval.harness import config_specs
 from more_agent.eval.metrics import rtp
 from more_agent.eval.store import RunConfig
-from more_agent.planners.base import EpisodeContext, HighLevelAction, StepTrace
+from more_agent.planners.base import EpisodeContext, Step, StepTrace
 from more_agent.planners.oracle import OraclePlanner
 from more_agent.records import EpisodeRecord, EpisodeSpec, LLMUsage
 from more_agent.robot import ActionResult
@@ -70,10 +70,10 @@ class _Idle:
     def observe(self) -> None:
         pass
 
-    def decide(self) -> HighLevelAction:
-        return HighLevelAction("wait")
+    def decide(self) -> Step:
+        return Step("wait")
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         return NOTHING_HAPPENS
 
     def step_trace(self) -> StepTrace:
@@ -86,8 +86,8 @@ class _Idle:
 class _DoneAtOnce(_Idle):
     """A planner that calls done() at its first step."""
 
-    def decide(self) -> HighLevelAction:
-        return HighLevelAction("done")
+    def decide(self) -> Step:
+        return Step("done")
 
 
 def test_step_limit_ends_the_episode_with_the_reason() -> None:
@@ -99,11 +99,11 @@ def test_step_limit_ends_the_episode_with_the_reason() -> None:
 class _SolveThenLinger(OraclePlanner):
     """The oracle, except that where it would call done() it keeps waiting instead."""
 
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         action = super().decide()
-        return HighLevelAction("wait") if action.is_done else action
+        return Step("wait") if action.is_done else action
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         return NOTHING_HAPPENS if action.name == "wait" else super().execute(action)
 
 
@@ -117,7 +117,7 @@ def test_acting_on_after_the_goal_holds_ends_after_five_steps_without_success() 
 
 
 class _Crashing(_Idle):
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         raise RuntimeError("planner bug")
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import reset_planner, run_episode
-from more_agent.planners.base import HighLevelAction, default_planner, make_planner
+from more_agent.planners.base import Step, default_planner, make_planner
 from more_agent.planners.grounded import GroundedPlanner
 from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import GROUND_M, Belief, StepOutcome, bind, learn_from_outcome, on_floor
@@ -88,7 +88,7 @@ def with_far_room(sit: Situation) -> tuple[Situation, str]:
 
 
 def learn(
-    belief: Belief, agenda: Agenda, sit: Situation, action: HighLevelAction, result: ActionResult, news: bool = False
+    belief: Belief, agenda: Agenda, sit: Situation, action: Step, result: ActionResult, news: bool = False
 ) -> None:
     """Let the belief learn from ``action`` ending in ``result`` where the robot stands."""
     outcome = StepOutcome(result, held=None, region=sit.here, news=news, path_length=len(sit.path))
@@ -225,7 +225,7 @@ def test_a_scope_the_goal_moves_binds_to_no_scene_fixture() -> None:
 def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInstance) -> None:
     belief, sit, agenda = state(planner_in(kitchen))
     scope, label = a_moved_item(belief, sit, agenda)
-    grasp = HighLevelAction("go_to_and_grasp", ("kitchen_0", label), belief.seen[label])
+    grasp = Step("go_to_and_grasp", ("kitchen_0", label), belief.seen[label])
     learn(belief, agenda, sit, grasp, ActionResult(ok=False, reason=FailureReason.HAND_FULL, feedback="hand is full"))
     assert belief.bound[scope] == label  # one failure of another kind: tried again
     refused = ActionResult(ok=False, reason=FailureReason.NOT_GRASPABLE, feedback=f"{label} cannot be picked up")

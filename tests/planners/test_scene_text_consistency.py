@@ -26,7 +26,7 @@ import pytest
 from more_agent.eval.episode import reset_planner, run_episode
 from more_agent.llm.completion import ChatMessage, Completion, TokenUsage
 from more_agent.llm.prompts import HISTORY_LAST_N, LASTING_SKILLS
-from more_agent.planners.base import HighLevelAction
+from more_agent.planners.base import Step
 from more_agent.planners.language import FLOOR, HELD, SceneView, room_names
 from more_agent.planners.llm_planner import PLANNER_CONFIGS, LLMClients, LLMPlanner
 from more_agent.records import ActionRecord, EpisodeSpec, HistoryMode
@@ -241,7 +241,7 @@ class CheckedPlanner(LLMPlanner):
             f"step {len(self.history)}: the scene text disagrees with its graph\n{view.text()}")
         check_deeds(view, graph, self.history, self.name, self.regions_seen)
 
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         action = super().decide()
         full, planning = read_text(self._view().text()), read_text((self.planning_view or self._view()).text())
         assert self._view().robot_room in planning or self._view().robot_room not in full

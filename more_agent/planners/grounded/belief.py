@@ -12,7 +12,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 from more_agent.goal import TaskGoal
-from more_agent.planners.base import HighLevelAction
+from more_agent.planners.base import Step
 from more_agent.planners.targets import Area
 from more_agent.records import FailureReason
 from more_agent.robot import XY, ActionResult
@@ -135,7 +135,7 @@ class StepOutcome:
     """Length of the robot's trajectory after the step."""
 
 
-def learn_from_outcome(belief: Belief, goal: TaskGoal, action: HighLevelAction, outcome: StepOutcome) -> None:
+def learn_from_outcome(belief: Belief, goal: TaskGoal, action: Step, outcome: StepOutcome) -> None:
     """Learn from an executed step: explores that revealed nothing, floor placements, containers looked
     into, furniture driven to, and failures (:func:`count_failure`)."""
     target, result = action.target, outcome.result
@@ -158,7 +158,7 @@ def learn_from_outcome(belief: Belief, goal: TaskGoal, action: HighLevelAction, 
         count_failure(belief, goal, action, target.label, outcome)
 
 
-def count_failure(belief: Belief, goal: TaskGoal, action: HighLevelAction, label: str, outcome: StepOutcome) -> None:
+def count_failure(belief: Belief, goal: TaskGoal, action: Step, label: str, outcome: StepOutcome) -> None:
     """Count a failure on the object ``label``; an action failing twice the same way drops it from the bindings
     (an approach: three times; what cannot be picked up: at once)."""
     result = outcome.result

@@ -4,7 +4,7 @@ the goal's agenda (package docstring, points 2 and 3; the search is :mod:`.searc
 from __future__ import annotations
 
 from more_agent.goal import Literal
-from more_agent.planners.base import DONE, HighLevelAction
+from more_agent.planners.base import DONE, Step
 from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief
 from more_agent.planners.grounded.literals import closes, floor_region, holds
@@ -20,12 +20,12 @@ def choose(belief: Belief, sit: Situation, agenda: Agenda) -> Choice:
     lost = sorted(label for label in belief.bound.values() if label in belief.dropped)
     if lost:
         why = f"cannot act on {', '.join(lost)}, which the description names"
-        return Choice(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up: {why}"))
+        return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up: {why}"))
     pending = [(lit, h) for lit, h in status if h is not True]
     if not pending:
         why = "; ".join(lit.text for lit in agenda.skipped)
         gave_up = f"goal literals no subpolicy achieves: {why}" if why else ""
-        return Choice(HighLevelAction(DONE, note="every goal literal holds in the scene graph", gave_up=gave_up))
+        return Choice(Step(DONE, note="every goal literal holds in the scene graph", gave_up=gave_up))
     held_node = sit.graph.held_object
     held = held_node.label if held_node is not None else None
     if held is not None:

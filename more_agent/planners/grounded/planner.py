@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 
-from more_agent.planners.base import DONE, EpisodeContext, HighLevelAction, StepTrace, needed
+from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.grounded.agenda import Agenda, agenda_of
 from more_agent.planners.grounded.belief import Belief, StepOutcome, learn_from_graph, learn_from_outcome
 from more_agent.planners.grounded.choose import choose
@@ -57,13 +57,13 @@ class GroundedPlanner:
         graph = needed(self.graph, "observe()")
         return Situation(graph, room_names(graph), body.xy, body.trajectory, body.builder.config.max_range_m)
 
-    def decide(self) -> HighLevelAction:
+    def decide(self) -> Step:
         """``done`` when every goal literal holds as far as the robot knows, else the next step."""
         choice = choose(self.belief, self.situation(), needed(self.agenda, "reset()"))
         self.belief.opened_in_a_row = self.belief.opened_in_a_row + 1 if choice.looking else 0
         return choice.action
 
-    def execute(self, action: HighLevelAction) -> ActionResult:
+    def execute(self, action: Step) -> ActionResult:
         """Run the skill on the step's target, and learn from its outcome."""
         body, graph = needed(self.body, "reset()"), needed(self.graph, "observe()")
         if action.name == DONE or action.target is None:

@@ -9,7 +9,7 @@ import numpy as np
 
 from more_agent.goal import Literal
 from more_agent.mapping import visible_unknown_area
-from more_agent.planners.base import DONE, HighLevelAction
+from more_agent.planners.base import DONE, Step
 from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief, bind
 from more_agent.planners.grounded.situation import Situation
@@ -72,7 +72,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     if region is not None:
         return explore_step(sit, region, note)
     why = f"{note}: nothing left to explore or open"
-    return Choice(HighLevelAction(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+    return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
 
 def closed_containers(belief: Belief, sit: Situation) -> list[ObjectNode]:
@@ -182,7 +182,7 @@ def explore_step(sit: Situation, region: str, note: str) -> Choice:
     """Explore ``region`` towards its far frontiers that show the most unseen floor."""
     far = far_frontiers(sit.graph.frontiers(region), sit.path)
     room = sit.names[region]
-    return Choice(HighLevelAction("explore", (room,), Area(room, region, informative(sit, far)), note=note))
+    return Choice(Step("explore", (room,), Area(room, region, informative(sit, far)), note=note))
 
 
 def informative(sit: Situation, frontiers: tuple[XY, ...]) -> tuple[XY, ...]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from more_agent.planners.base import HighLevelAction
+from more_agent.planners.base import Step
 from more_agent.planners.goal_order import PUT_DOWN_MAX_TOP_M
 from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief
@@ -20,20 +20,20 @@ class Choice:
     """A chosen step (its typed target included), and whether it opens a container to look inside
     (the search counts those in a row, ``search.OPENS_BEFORE_EXPLORING``)."""
 
-    action: HighLevelAction
+    action: Step
     looking: bool = False
 
 
 def object_step(sit: Situation, skill: str, label: str, note: str) -> Choice:
     """``skill`` on the object ``label`` of the step's graph."""
     obj = sit.graph.objects[label]
-    return Choice(HighLevelAction(skill, (sit.room(obj.region_id), label), obj, note=note))
+    return Choice(Step(skill, (sit.room(obj.region_id), label), obj, note=note))
 
 
 def floor_step(sit: Situation, region: str, note: str) -> Choice:
     """Put what the hand holds on the floor of ``region``."""
     room = sit.room(region)
-    return Choice(HighLevelAction("go_to_and_place_ontop", (room, FLOOR), Area(room, region), note=note))
+    return Choice(Step("go_to_and_place_ontop", (room, FLOOR), Area(room, region), note=note))
 
 
 def reachable(belief: Belief, sit: Situation) -> set[str]:
@@ -50,7 +50,7 @@ def put_down(belief: Belief, sit: Situation, agenda: Agenda, held: str) -> Choic
     if support is not None:
         return object_step(sit, "go_to_and_place_ontop", support, note)
     room = sit.room(sit.here)
-    return Choice(HighLevelAction("go_to_and_place_ontop", (room, FLOOR), Area(room), note=note))
+    return Choice(Step("go_to_and_place_ontop", (room, FLOOR), Area(room), note=note))
 
 
 def off_floor(belief: Belief, agenda: Agenda, held: str, region: str | None) -> bool:
