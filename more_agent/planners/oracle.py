@@ -131,8 +131,8 @@ class OraclePlanner:
         self._intent: Literal | None = None
         """The literal the held item was grasped for."""
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
-        self._last_failure: dict[tuple[str, tuple[str, ...]], tuple[str, str | None]] = {}
-        """Per action, the feedback and blocking door of its last failure."""
+        self._last_failure: dict[tuple[str, tuple[str, ...]], ActionResult] = {}
+        """Per action, its last failure: compared by typed reason and blocking door; its feedback explains a give-up."""
         self._body = Embodiment(context.robot)
         self._trace_graphs = context.trace_graphs
         self._graph: SceneGraph | None = None
@@ -181,7 +181,7 @@ class OraclePlanner:
         action = self._door_action() or self._next(pending)
         key = (action.name, action.arguments)
         if self._failures[key] >= MAX_FAILURES_PER_ACTION:
-            why = self._last_failure[key][0]
+            why = self._last_failure[key].feedback
             note = (
                 f"oracle gave up: {action.name} {' '.join(action.arguments)} failed {self._failures[key]} times ({why})"
             )
@@ -329,11 +329,12 @@ class OraclePlanner:
                 self._observed.update(o.name for o in world.descendants(arg) if world.is_observable(o.name))
         else:
             key = (action.name, action.arguments)
-            # A different failure (another door in the way, even one not yet seen, whose feedback
-            # names it by category only) is progress; the same one twice is not.
-            failure = (result.feedback, result.blocking)
-            self._failures[key] = self._failures[key] + 1 if self._last_failure.get(key) == failure else 1
-            self._last_failure[key] = failure
+            # A different failure (another reason, another door in the way, even one not yet seen)
+            # is progress; the same one twice is not.
+            last = self._last_failure.get(key)
+            same = last is not None and (last.reason, last.blocking) == (result.reason, result.blocking)
+            self._failures[key] = self._failures[key] + 1 if same else 1
+            self._last_failure[key] = result
             if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR:
                 self._door = result.blocking
         return result

@@ -233,6 +233,23 @@ def test_an_object_that_cannot_be_picked_up_is_dropped_at_once(kitchen: TaskInst
     assert scope not in belief.bound and label in belief.dropped and bind(belief, agenda.goal, scope, sit.xy) != label
 
 
+def test_failures_count_by_typed_reason_and_door_never_by_feedback_text(kitchen: TaskInstance) -> None:
+    """Two failures of one action with the same reason are the same way of failing whatever their feedback
+    says; another door in the way is progress."""
+    belief, sit, agenda = state(planner_in(kitchen))
+    scope, label = a_moved_item(belief, sit, agenda)
+    grasp = Step("go_to_and_grasp", ("kitchen_0", label), belief.seen[label])
+
+    def blocked(door: str, text: str) -> ActionResult:
+        return ActionResult(ok=False, reason=FailureReason.PATH_BLOCKED_BY_DOOR, feedback=text, blocking=door)
+
+    learn(belief, agenda, sit, grasp, blocked("door A", "the way is blocked by closed door A"))
+    learn(belief, agenda, sit, grasp, blocked("door B", "the way is blocked by closed door B"))
+    assert belief.bound[scope] == label  # another door each time: tried again
+    learn(belief, agenda, sit, grasp, blocked("door B", "blocked by a door"))  # door B again, worded otherwise
+    assert scope not in belief.bound and label in belief.dropped
+
+
 def test_what_lies_on_the_ground_is_on_its_floor_and_goes_on_furniture_to_be_off_it(kitchen: TaskInstance) -> None:
     belief, sit, agenda = state(planner_in(kitchen))
     fridge = belief.seen["fridge A"]

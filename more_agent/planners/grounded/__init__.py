@@ -32,10 +32,10 @@ Every step (MPC style) it rebuilds the scene graph and:
    explores revealed nothing new yields to the other containers and closed doors; the planner
    gives up with ``done`` when nothing is left to try.
 
-An action that fails twice the same way is not repeated: its target is dropped from the bindings
-(another instance is taken) or, for a named instance, the planner gives up. An object that cannot be
-picked up is dropped at once (a category can be both: a store's cartons are furniture, a task's are
-items). Regions are labelled with the room type their furniture fits best
+An action that fails twice the same way (its typed reason and the door in the way) is not repeated: its
+target is dropped from the bindings (another instance is taken) or, for a named instance, the planner
+gives up. An object that cannot be picked up is dropped at once (a category can be both: a store's
+cartons are furniture, a task's are items). Regions are labelled with the room type their furniture fits best
 (:mod:`more_agent.planners.room_types`).
 
 The package: what the planner has learnt is a :class:`~.belief.Belief` (``belief.py``), updated after

@@ -31,8 +31,8 @@ GROUND_M = 0.05
 Relation = tuple[str, str]
 """(predicate 'inside' / 'ontop', label of the container / support, or 'floor <room>')."""
 
-FailureKey = tuple[str, tuple[str, ...], str]
-"""(skill, arguments, how it failed): failures counted the same way."""
+FailureKey = tuple[str, tuple[str, ...], FailureReason | None, str | None]
+"""(skill, arguments, typed reason, the closed door in the way): failures counted as the same way of failing."""
 
 
 @dataclass
@@ -159,15 +159,16 @@ def learn_from_outcome(belief: Belief, goal: TaskGoal, action: Step, outcome: St
 
 
 def count_failure(belief: Belief, goal: TaskGoal, action: Step, label: str, outcome: StepOutcome) -> None:
-    """Count a failure on the object ``label``; an action failing twice the same way drops it from the bindings
-    (an approach: three times; what cannot be picked up: at once)."""
+    """Count a failure on the object ``label``; an action failing twice the same way (its typed reason, and
+    the door in the way: another door is progress) drops it from the bindings (an approach: three times;
+    what cannot be picked up: at once). No feedback text is compared."""
     result = outcome.result
+    key = (action.name, action.arguments, result.reason, result.blocking)
     if result.reason is FailureReason.NOT_REACHABLE:
         belief.out_of_reach[label] = outcome.path_length
-        key, limit = (action.name, action.arguments, "not reachable"), MAX_REACH_FAILURES
+        limit = MAX_REACH_FAILURES
     else:  # furniture cannot be picked up however often the robot tries
         limit = 1 if result.reason is FailureReason.NOT_GRASPABLE else MAX_FAILURES
-        key = (action.name, action.arguments, result.feedback)
     belief.failures[key] += 1
     if belief.failures[key] < limit:
         return

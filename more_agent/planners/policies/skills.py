@@ -167,7 +167,8 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     """Put the held item on the floor: where the robot stands, or in ``region_id`` after driving to the
     region's navigation node closest to its centre (floors are the rooms themselves, not graph objects)."""
     start = body.low_level_steps
-    if body.robot.held is None:
+    held = body.robot.held
+    if held is None:
         return _fail(FailureReason.HAND_EMPTY, "hand is empty")
     if region_id is not None and graph.robot.region_id != region_id:
         region = graph.regions[region_id]
@@ -185,10 +186,15 @@ def place_on_floor(body: Embodiment, graph: SceneGraph, region_id: str | None, r
     body.sense_after(result)
     if result.ok:
         body.sense()  # the hand is empty now: without a frame the graph would still show the item held
-    feedback = result.feedback if not result.ok else result.feedback.rsplit(" on ", 1)[0] + f" on the floor of {room}"
+    feedback = f"placed {_held_label(graph, held)} on the floor of {room}" if result.ok else result.feedback
     return ActionResult(
         ok=result.ok, reason=result.reason, feedback=feedback, low_level_steps=body.low_level_steps - start
     )
+
+
+def _held_label(graph: SceneGraph, instance_id: int) -> str:
+    """What the step's graph calls the held instance ('the item' when it shows none)."""
+    return next((o.label for o in graph.objects.values() if o.instance_id == instance_id), "the item")
 
 
 # -- dispatch through the skill table -----------------------------------------------------------
