@@ -3,8 +3,9 @@
 The paper's BUMBLE adaptation (supplementary "BUMBLE Implementation") samples frames continuously
 during execution so the VLM can pick a frame showing a previously seen object (landmark step) or an
 unexplored area (exploration). Here every rendered frame is offered to the buffer, which keeps it
-when the camera has moved at least ``min_move_m`` or turned at least ``min_turn_deg`` since the last
-kept frame (the initial full turn keeps every view: its turns are about 35 degrees).
+when the camera has moved or turned far enough since the last kept frame: the rule and default
+(0.5 m or 30 degrees) of the mapper's :class:`~more_agent.planners.policies.sensing.SensingCadence`
+(the initial full turn keeps every view: its turns are about 33 degrees).
 
 A kept frame holds its pose and its RGB, instance and coarse depth images compressed (about 12 kB
 per frame); the PNG a request sends is encoded the first time the frame is sent. Which objects a
@@ -24,6 +25,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.llm.images import png_bytes
+from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.robot import Frame
 from more_agent.sim.camera import project
 
@@ -36,13 +38,11 @@ class MemoryConfig(BaseModel):
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    min_move_m: float = Field(
-        default=0.5, gt=0, description="Keep a frame after the camera moved this far since the last kept one."
+    keep: SensingCadence = Field(
+        default_factory=SensingCadence,
+        description="Keep a frame once the camera moved or turned this far since the last kept one (the mapper's rule).",
     )
-    min_turn_deg: float = Field(default=30.0, gt=0, description="... or turned this much.")
-    max_images: int = Field(
-        default=8, ge=1, description="Most buffer frames in one VLM request (the buffer is subsampled beyond)."
-    )
+    max_images: int = Field(default=8, ge=1, description="Most buffer frames in one VLM request (subsampled beyond).")
     occlusion_margin_m: float = Field(
         default=0.3,
         ge=0,
@@ -122,6 +122,8 @@ class VisualMemory:
 
     def __init__(self, config: MemoryConfig | None = None) -> None:
         self.config = config or MemoryConfig()
+        self.schedule = SensingSchedule(self.config.keep)
+        """When the next frame is kept: the rule the embodiment's mapper fuses frames on the way by."""
         self.frames: list[MemoryFrame] = []
         self.step = 0
         """The high-level step frames are captured in now (the planner advances it)."""
@@ -129,11 +131,9 @@ class VisualMemory:
     def offer(self, frame: Frame) -> MemoryFrame | None:
         """Keep ``frame`` if the camera moved or turned enough since the last kept frame; the new entry or None."""
         pose = camera_pose(frame.T_world_cam)
-        if self.frames:
-            x, y, yaw = self.frames[-1].pose
-            turned = abs(math.degrees(math.atan2(math.sin(pose[2] - yaw), math.cos(pose[2] - yaw))))
-            if math.dist((x, y), pose[:2]) < self.config.min_move_m and turned < self.config.min_turn_deg:
-                return None
+        if not self.schedule.due(*pose):
+            return None
+        self.schedule.fused(*pose)
         kept = memory_frame(frame, index=len(self.frames), step=self.step)
         self.frames.append(kept)
         return kept

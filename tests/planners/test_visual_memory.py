@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from more_agent.llm.errors import InvalidAnswer
+from more_agent.planners.policies.sensing import SensingCadence
 from more_agent.planners.visual_memory import (
     MemoryConfig,
     VisualMemory,
@@ -37,6 +38,14 @@ def test_buffer_keeps_a_frame_per_half_metre_or_thirty_degrees() -> None:
     kept = [memory.offer(_frame(*p)) is not None for p in poses]
     assert kept == [True, False, False, True, False, True]
     assert [f.index for f in memory.frames] == [0, 1, 2] and memory.since(1) == memory.frames[1:]
+
+
+def test_buffer_keeps_frames_by_the_mappers_cadence() -> None:
+    """The buffer's rule is the embodiment's sensing cadence (``SensingCadence``), by default and when set."""
+    assert MemoryConfig().keep == SensingCadence()
+    memory = VisualMemory(MemoryConfig(keep=SensingCadence(distance_m=1.0, angle_deg=45.0)))
+    poses = [(0, 0, 0), (0.6, 0, 0), (1.0, 0, 0), (1.0, 0, math.radians(40)), (1.0, 0, math.radians(46))]
+    assert [memory.offer(_frame(*p)) is not None for p in poses] == [True, False, True, False, True]
 
 
 def test_kept_frame_round_trips_its_images() -> None:
