@@ -75,8 +75,10 @@ def test_report_json_has_table_i_per_system_and_task(tmp_path: Path) -> None:
 
 
 SLOW_IMPORTS = ("scipy.signal", "scipy.optimize", "matplotlib", "skimage.measure", "numba", "openai",
-                "more_agent.eval.episode", "more_agent.llm.client", "more_agent.planners", "more_agent.mapping")
-"""Modules a listing never needs (scipy.signal alone took a second, through skimage.measure)."""
+                "more_agent.eval.episode", "more_agent.llm.client", "more_agent.planners", "more_agent.mapping",
+                "more_agent.records")
+"""Modules a listing never needs (scipy.signal alone took a second, through skimage.measure; the episode
+records' pydantic models a tenth of one)."""
 
 
 def _imported(args: list[str]) -> set[str]:

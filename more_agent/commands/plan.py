@@ -10,19 +10,24 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from pydantic import TypeAdapter, ValidationError
 from rich.text import Text
 
 from more_agent.commands._common import EXIT_FAILED, EXIT_RETRYABLE, console, print_error, user_errors_exit_2
 from more_agent.errors import UserError
-from more_agent.records import ActionRecord
+
+if TYPE_CHECKING:
+    from more_agent.records import ActionRecord
 
 
 def read_history(path: Path) -> list[ActionRecord]:
     """A history file: a JSON list of actions (``episode.json``'s ``actions``), or an ``episode.json``."""
+    from pydantic import TypeAdapter, ValidationError
+
+    from more_agent.records import ActionRecord
+
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
         actions = data.get("actions", []) if isinstance(data, dict) else data

@@ -34,11 +34,11 @@ from more_agent.commands._common import (
     user_errors_exit_2,
 )
 from more_agent.errors import UserError, check_writable_dir
-from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import for_terminal
 
 if TYPE_CHECKING:
     from more_agent.interop.bag_writer import BagRecorder
+    from more_agent.records import EpisodeRecord
 
 NO_LLM_MESSAGE = (
     "No LLM configured: running the grounded planner (goal-aware, no LLM, through the same scene graph "
@@ -164,6 +164,7 @@ def run(
     from more_agent.llm.prompts import check_history
     from more_agent.perception_spec import parse_perception
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
+    from more_agent.records import EpisodeSpec
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task

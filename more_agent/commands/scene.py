@@ -15,6 +15,7 @@ from more_agent.commands._common import (
     JsonOption,
     check_output_file,
     console,
+    print_columns,
     print_json,
     user_errors_exit_2,
 )
@@ -37,11 +38,12 @@ def list_(as_json: JsonOption = False) -> None:
     if as_json:
         print_json([{"scene": name, "rooms": list(catalog.scene_rooms(name))} for name in catalog.scene_names()])
         return
-    table = Table("scene", "rooms", "room ids")
-    for name in catalog.scene_names():
+    names = catalog.scene_names()
+    rows = []
+    for name in names:
         rooms = list(catalog.scene_rooms(name))
-        table.add_row(name, str(len(rooms)), ", ".join(rooms))
-    console.print(table)
+        rows.append([name, str(len(rooms)), ", ".join(rooms)])
+    print_columns(f"{len(names)} scenes", ["scene", "rooms", "room ids"], rows)
 
 
 @app.command("show")

@@ -12,6 +12,7 @@ from more_agent.commands._common import (
     MAX_SEED,
     JsonOption,
     console,
+    print_columns,
     print_json,
     user_errors_exit_2,
 )
@@ -47,18 +48,19 @@ def list_(
             ]
         )
         return
-    table = Table(title=f"{len(names)} tasks" + (f" in {set_}" if set_ else ""))
-    table.add_column("task", no_wrap=True)
-    for col in ("objects", "goal literals", "instantiable", "scenes"):
-        table.add_column(col)
+    rows = []
     for name in names:
         e = data[name]
         scenes = e["scenes"]
         shown = ", ".join(scenes[:3]) + (f" (+{len(scenes) - 3})" if len(scenes) > 3 else "")
-        table.add_row(
-            name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-"
+        rows.append(
+            [name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-"]
         )
-    console.print(table)
+    print_columns(
+        f"{len(names)} tasks" + (f" in {set_}" if set_ else ""),
+        ["task", "objects", "goal literals", "instantiable", "scenes"],
+        rows,
+    )
 
 
 @app.command("show")
