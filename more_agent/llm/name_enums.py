@@ -49,8 +49,9 @@ def constrains_names(client: object) -> bool:
     return bool(getattr(client, "name_enums", False))
 
 
-NO_ITEMS: dict[str, Any] = {"prefixItems": []}
-"""Schema of an argument list that holds nothing (``done()``), in the form llama.cpp's grammar reads."""
+NO_ITEMS: dict[str, Any] = {"items": {"type": "string"}}
+"""Items of an argument list that holds nothing (``done()``, ``maxItems`` 0): without any, llama.cpp's
+grammar reads the list as "any JSON array" (and JSON Schema forbids an empty ``prefixItems``)."""
 
 
 def constrains_positions(client: object) -> bool:
@@ -110,7 +111,6 @@ def per_skill_answer(
             continue
         positions = tuple(Literal.__getitem__(tuple(valid[kind])) for kind in skill.params)
         arguments: Any = tuple.__class_getitem__(positions) if positions else tuple[()]
-        # an empty tuple's schema has no items, which llama.cpp reads as "any array": say none
         info = arguments_info if positions else FieldInfo.merge_field_infos(arguments_info, json_schema_extra=NO_ITEMS)
         variants.append(
             create_model(

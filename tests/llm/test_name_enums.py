@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import jsonschema
 import pytest
 from pydantic import ValidationError
 
@@ -135,7 +136,9 @@ def test_per_skill_answers_constrain_each_argument_position() -> None:
     assert all(list(p) == ["analysis", "reasoning", "skill", "arguments"] for p in shapes.values())
     assert shapes["explore"]["arguments"]["prefixItems"] == [{"enum": ROOMS, "type": "string"}]
     assert [i["enum"] for i in shapes["go_to_and_grasp"]["arguments"]["prefixItems"]] == [ROOMS, sorted(OBJECTS)]
-    assert shapes["done"]["arguments"]["prefixItems"] == [] and shapes["done"]["arguments"]["maxItems"] == 0
+    assert shapes["done"]["arguments"]["maxItems"] == 0 and shapes["done"]["arguments"]["items"] == {"type": "string"}
+    jsonschema.Draft202012Validator.check_schema(schema)  # a valid schema (no empty prefixItems)
+    jsonschema.validate({"analysis": "", "reasoning": "", "skill": "done", "arguments": []}, schema)
     valid = {"analysis": "", "reasoning": "", "skill": "go_to_and_grasp", "arguments": ["kitchen_0", "apple A"]}
     model.model_validate(valid)
     for wrong in (["apple A", "kitchen_0"], ["kitchen_0"], ["kitchen_0", "apple A", "sofa A"]):
