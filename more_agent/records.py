@@ -225,6 +225,9 @@ class EpisodeRecord(BaseModel):
     task: str = Field(description="BEHAVIOR-1K activity name.")
     scene: str = Field(description="Scene name, e.g. 'Rs_int'.")
     seed: int = Field(description="Seed of scene generation and task instantiation.")
+    trial: int = Field(
+        default=0, ge=0, description="Trial of this (task, scene, seed) world, from 0 (``eval --trials``)."
+    )
     planner: str = Field(
         description="Planner name: 'oracle', 'more', 'moma-llm', 'moma-llm-sr', 'bumble', 'bumble-filter'."
     )
@@ -246,6 +249,15 @@ class EpisodeRecord(BaseModel):
     )
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
+    )
+    long_term_memory: bool = Field(
+        default=False,
+        description="Whether the planner was given the failure summaries of earlier trials (BUMBLE's --add_past).",
+    )
+    failure_summaries: list[str] = Field(
+        default_factory=list,
+        description="Long-term memory this episode leaves for the later trials of its task: one summary per failed "
+        "step (BUMBLE; empty for planners without one).",
     )
     misperceived: dict[str, str] = Field(
         default_factory=dict,
@@ -300,9 +312,9 @@ class EpisodeRecord(BaseModel):
             data, version = UPGRADES[version](data), version + 1
         return data
 
-    def key(self) -> tuple[str, str, int, str]:
-        """Identity of the episode within a run: (task, scene, seed, planner)."""
-        return (self.task, self.scene, self.seed, self.planner)
+    def key(self) -> tuple[str, str, int, str, int]:
+        """Identity of the episode within a run: (task, scene, seed, planner, trial)."""
+        return (self.task, self.scene, self.seed, self.planner, self.trial)
 
     @classmethod
     def for_spec(cls, spec: EpisodeSpec, **fields: object) -> EpisodeRecord:
@@ -311,13 +323,14 @@ class EpisodeRecord(BaseModel):
             task=spec.task,
             scene=spec.scene or "",
             seed=spec.seed,
+            trial=spec.trial,
             planner=spec.planner,
             **episode_settings(spec),
             **fields,
         )
 
 
-EPISODE_SETTINGS = ("llm", "start", "distractors", "descriptions", "history", "perception")
+EPISODE_SETTINGS = ("llm", "start", "distractors", "descriptions", "history", "perception", "long_term_memory")
 """The settings an episode shares with its run beside (task, scene, seed, planner): the one list that
 specs, records and folder names copy from each other, so a new setting is added here once."""
 
@@ -335,6 +348,7 @@ class EpisodeSpec(FrozenModel):
         default=None, description="Scene name; None draws one with the seed among the task's suitable scenes."
     )
     seed: int = Field(default=0, description="Seed of scene generation and task instantiation.")
+    trial: int = Field(default=0, ge=0, description="Trial of this (task, scene, seed) world, from 0.")
     planner: str = Field(default="oracle", description="Planner name.")
     llm: str | None = Field(default=None, description="LLM spec such as 'openai:gpt-4o'; None for the oracle.")
     start: str = Field(
@@ -352,6 +366,14 @@ class EpisodeSpec(FrozenModel):
     history: HistoryMode = Field(default=DEFAULT_HISTORY, description="Action history shown to LLM and VLM planners.")
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
+    )
+    long_term_memory: bool = Field(
+        default=False, description="Give the planner the failure summaries of earlier trials (BUMBLE's --add_past)."
+    )
+    past_failures: tuple[str, ...] = Field(
+        default=(),
+        description="With long_term_memory: the failure summaries the earlier trials of this task left, oldest first "
+        "(filled by the harness from their records, or by `run --bumble-memory` from its file).",
     )
 
     @field_validator("perception")

@@ -54,6 +54,8 @@ MAX_SEED = 2**32 - 1
 """Largest seed (numpy's seeds are 32-bit words; a 240-digit seed would only make a too-long folder name)."""
 MAX_SEEDS = 10_000
 """Largest ``eval --seeds`` (10,000 seeds per task is already weeks of episodes)."""
+MAX_TRIALS = 100
+"""Largest ``eval --trials``."""
 
 F = TypeVar("F", bound=Callable[..., object])
 
@@ -126,19 +128,11 @@ def use_room_llm(spec: str | None) -> None:
 BumbleMemoryOption = Annotated[
     Path | None,
     typer.Option(
-        help="BUMBLE's long-term memory (its --add_past): a JSON Lines file of failure summaries, read at the start "
-        "of each BUMBLE episode of a task and appended to on each failed step (also MORE_AGENT_BUMBLE_MEMORY)."
+        help="BUMBLE's long-term memory across runs (its --add_past): a JSON Lines file of failure summaries per "
+        "task, read before the episode and appended to after it (eval: --trials N --long-term-memory)."
     ),
 ]
-"""``--bumble-memory`` of ``run`` and ``eval``."""
-
-
-def use_bumble_memory(path: Path | None) -> None:
-    """Make ``path`` the BUMBLE long-term memory file of this process and its workers (``MORE_AGENT_BUMBLE_MEMORY``)."""
-    if path is not None:
-        from more_agent.planners.bumble_memory import ENV_MEMORY
-
-        os.environ[ENV_MEMORY] = str(path.resolve())
+"""``--bumble-memory`` of ``run``."""
 
 
 JsonOption = Annotated[

@@ -12,7 +12,7 @@ from more_agent.commands._common import (
     EXIT_FAILED,
     EXIT_RETRYABLE,
     MAX_SEEDS,
-    BumbleMemoryOption,
+    MAX_TRIALS,
     DescriptionsOption,
     DistractorsOption,
     HistoryOption,
@@ -21,7 +21,6 @@ from more_agent.commands._common import (
     StartOption,
     episodes_exit_status,
     err_console,
-    use_bumble_memory,
     use_room_llm,
     user_errors_exit_2,
 )
@@ -40,8 +39,20 @@ def eval_(
     out: Annotated[Path, typer.Option(help="Run directory (episodes.jsonl, run.json, reports).")],
     llm: Annotated[str | None, typer.Option(help="LLM spec, e.g. 'openai:gpt-4o'.")] = None,
     room_llm: RoomLLMOption = None,
-    bumble_memory: BumbleMemoryOption = None,
     seeds: Annotated[int, typer.Option(min=1, max=MAX_SEEDS, help="Seeds per task: 0 .. N-1.")] = 1,
+    trials: Annotated[
+        int,
+        typer.Option(
+            min=1, max=MAX_TRIALS, help="Trials of every task and seed, run in sequence (records carry the trial)."
+        ),
+    ] = 1,
+    long_term_memory: Annotated[
+        bool,
+        typer.Option(
+            help="Give each trial the failure summaries of its world's earlier trials (BUMBLE's --add_past; "
+            "only BUMBLE planners keep them)."
+        ),
+    ] = False,
     scene: Annotated[
         str | None,
         typer.Option(help="Scene for every task (default: drawn per episode among each task's suitable scenes)."),
@@ -83,7 +94,7 @@ def eval_(
     """
     from more_agent import __version__
     from more_agent.eval.harness import DEFAULT_EPISODE_FN, VIEWER_EPISODE_FN, check_task_names, evaluate, resolve_tasks
-    from more_agent.eval.report import load_runs, table_i_markdown
+    from more_agent.eval.report import has_trials, llm_markdown, load_runs, table_i_markdown, trials_markdown
     from more_agent.eval.report_writer import write_reports
     from more_agent.eval.store import RunConfig, check_run_dir
     from more_agent.llm import parse_llm_spec
@@ -105,7 +116,6 @@ def eval_(
     if llm is not None:
         parse_llm_spec(llm)  # a bad spec or one holding credentials fails here
     use_room_llm(room_llm)
-    use_bumble_memory(bumble_memory)
     names = resolve_tasks(tasks)
     check_start(start)
     check_description_mode(descriptions)
@@ -135,6 +145,8 @@ def eval_(
         descriptions=descriptions,
         history=history_mode,
         perception=perception_mode,
+        trials=trials,
+        long_term_memory=long_term_memory,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,
         workers=workers,
         ray_address=ray_address,
@@ -152,7 +164,12 @@ def eval_(
     )
     sourced, _ = load_runs([out])
     paths = write_reports(sourced, out, title=f"{planner} on {tasks}")
-    typer.echo(table_i_markdown([s.record for s in sourced]))
+    done = [s.record for s in sourced]
+    typer.echo(table_i_markdown(done))
+    if has_trials(done):
+        typer.echo("\n" + trials_markdown(done))
+    if any(r.llm for r in done):
+        typer.echo("\n" + llm_markdown(done))
     errors = sum(r.error is not None for r in records)
     if errors:
         err_console.print(

@@ -29,7 +29,6 @@ from more_agent.commands._common import (
     StartOption,
     console,
     episodes_exit_status,
-    use_bumble_memory,
     use_room_llm,
     user_errors_exit_2,
 )
@@ -164,6 +163,7 @@ def run(
     from more_agent.llm.prompts import check_history
     from more_agent.perception_spec import parse_perception
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
+    from more_agent.planners.bumble_memory import FailureStore
     from more_agent.records import EpisodeSpec
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start import check_start
@@ -171,7 +171,7 @@ def run(
 
     load_task(task)  # an unknown task fails first, with the closest names
     use_room_llm(room_llm)
-    use_bumble_memory(bumble_memory)
+    store = FailureStore(bumble_memory) if bumble_memory is not None else None
     check_start(start)
     check_description_mode(descriptions)
     history_mode = check_history(history)
@@ -196,6 +196,8 @@ def run(
         descriptions=descriptions,
         history=history_mode,
         perception=perception_mode,
+        long_term_memory=store is not None,
+        past_failures=tuple(store.summaries(task)) if store is not None else (),
     )
     recorder = open_bag_recorder(bag, bag_storage) if bag is not None else None
     with (
@@ -213,6 +215,8 @@ def run(
             planner=agent,
             bag=recorder,
         )
+    if store is not None:
+        store.add(task, record.failure_summaries)
     console.print(summary_table(record, out_dir))
     if recorder is not None:
         console.print(Text(f"bag: {bag} ({recorder.frames} frames, {bag_storage})"))

@@ -13,7 +13,7 @@ an :class:`~more_agent.eval.episode_folder.EpisodeFolder` writes the episode's f
 the map, each step's timeline line and the planner's step trace. Timings are seconds per phase:
 instantiate, sense, plan, act (goal checks included), write, total, and ``llm`` (waiting for
 answers, part of plan) for LLM planners. Everything else in the record
-is a function of (task, scene, seed, planner, llm).
+is a function of (task, scene, seed, planner, llm) and, for a later trial, the long-term memory it was given.
 """
 
 from __future__ import annotations
@@ -163,6 +163,7 @@ def run_episode(
             on_frame=bag.hook(world, instance.labels, then=on_frame) if bag is not None else on_frame,
             trace_graphs=folder is not None and folder.graphs,
             perception=perception,
+            past_failures=spec.past_failures,
         )
         clock.add("sense", t)
         if folder is not None:
@@ -209,10 +210,12 @@ def reset_planner(
     on_frame: Callable[[Frame], None] | None = None,
     trace_graphs: bool = False,
     perception: NoisyPerception | None = None,
+    past_failures: tuple[str, ...] = (),
 ) -> tuple[SimRobot, PrivilegedContext | None]:
     """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
     gets every frame it renders; with ``perception``, the planner drives it through a
-    :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`), grant the
+    :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`) and the
+    ``past_failures`` of earlier trials, grant the
     world and the goal checker to a privileged planner (one with ``grant``: the oracle), then ``reset``
     it. Returns the simulator's robot and the privileged context (None for any other planner)."""
     from more_agent.perception.robot import NoisyRobot
@@ -226,7 +229,16 @@ def reset_planner(
         grant(privileged)
     goal = goal_spec(instance, goals, descriptions, with_goal=getattr(planner, "reads_goal", False))
     driven = robot if perception is None else NoisyRobot(robot, perception)
-    planner.reset(EpisodeContext(robot=driven, goal=goal, llm=planner.llm, history=history, trace_graphs=trace_graphs))
+    planner.reset(
+        EpisodeContext(
+            robot=driven,
+            goal=goal,
+            llm=planner.llm,
+            history=history,
+            past_failures=past_failures,
+            trace_graphs=trace_graphs,
+        )
+    )
     return robot, privileged
 
 
@@ -341,3 +353,4 @@ def _finish(
     record.goal_conditions = list(status.conditions)
     record.observed_objects = observed_task_objects(scope, observed)
     record.llm_usage = planner.llm_usage()
+    record.failure_summaries = list(getattr(planner, "failure_summaries", ()))  # only BUMBLE keeps them

@@ -34,6 +34,7 @@ from more_agent.eval.store import (
     pending,
     prepare_run_dir,
     retire_retryable,
+    with_past_failures,
 )
 from more_agent.eval.worker import error_record, execute_episode, resolve_episode_fn
 from more_agent.interrupts import ignore_interrupts, interrupted
@@ -110,15 +111,17 @@ def _is_file(path: Path) -> bool:
 
 
 def config_specs(config: RunConfig) -> list[EpisodeSpec]:
-    """Every episode of a run: tasks x seeds, task-major."""
+    """Every episode of a run: trials x tasks x seeds, trial-major (the trials of a world run in sequence)."""
     return [
         EpisodeSpec(
             task=t,
             scene=config.scene,
             seed=s,
+            trial=k,
             planner=config.planner,
             **episode_settings(config),
         )
+        for k in range(config.trials)
         for t in config.tasks
         for s in config.seeds
     ]
@@ -291,10 +294,10 @@ def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeR
     from more_agent.eval.episode import redraw_map
     from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
 
-    by_key = {(r.task, r.seed, r.planner, r.llm, r.start): r for r in records}
+    by_key = {(r.task, r.seed, r.trial, r.planner, r.llm, r.start): r for r in records}
     redrawn = 0
     for spec in config_specs(config):
-        record = by_key.get((spec.task, spec.seed, spec.planner, spec.llm, spec.start))
+        record = by_key.get((spec.task, spec.seed, spec.trial, spec.planner, spec.llm, spec.start))
         out_dir = episode_dir(run_dir, spec)
         if record is None or not record.trajectory or not out_dir.is_dir() or map_is_complete(out_dir / MAP_FILE):
             continue
@@ -320,32 +323,15 @@ def _run_pending(
     show_progress: bool,
     console: Console | None,
 ) -> list[EpisodeRecord]:
-    """Run the episodes of ``config`` that have no record in ``records``, appending to the locked run folder."""
-    todo = pending(config_specs(config), records)
-    if config.ray_address:
-        from more_agent.eval.ray_backend import iter_ray
+    """Run the episodes of ``config`` that have no record in ``records``, appending to the locked run folder.
 
-        stream: Iterable[EpisodeRecord] = iter_ray(
-            todo,
-            fn_path=config.episode_fn,
-            run_dir=run_dir,
-            address=config.ray_address,
-            max_concurrent_llm=max_concurrent_llm,
-            max_retries=max_retries,
-        )
-    elif config.workers > 1 and len(todo) > 1:
-        stream = iter_processes(
-            todo,
-            fn_path=config.episode_fn,
-            run_dir=run_dir,
-            workers=config.workers,
-            start_method=start_method,
-            max_concurrent_llm=max_concurrent_llm,
-            max_retries=max_retries,
-        )
-    else:
-        stream = iter_inline(todo, fn_path=config.episode_fn, run_dir=run_dir)
+    Trials run in rounds: trial k of every world, then trial k + 1, each given (with ``long_term_memory``)
+    the failure summaries the records of its world's earlier trials hold (:func:`with_past_failures`).
+    A trial whose earlier trials have no result yet is held back and said so.
+    """
+    todo = pending(config_specs(config), records)
     console = console or Console(stderr=True)
+    held = 0
     with EpisodeWriter(run_dir / EPISODES_FILE) as writer, _progress(console, show=show_progress) as bar:
         successes, errors = sum(r.success for r in records), sum(r.error is not None for r in records)
         done = len(records)
@@ -354,11 +340,58 @@ def _run_pending(
             return {"sr": f"{successes / done:.1%}" if done else "-", "errors": str(errors)}
 
         bar_id = bar.add_task(config.planner, total=len(todo), **fields())
-        for record in stream:
-            if interrupted():  # Ctrl-C that native code turned into an ordinary error: not a result
-                raise KeyboardInterrupt
-            writer.append(record)
-            records.append(record)
-            done, successes, errors = done + 1, successes + record.success, errors + (record.error is not None)
-            bar.update(bar_id, advance=1, **fields())
+        for trial in range(config.trials):
+            ready = [with_past_failures(s, records) for s in todo if s.trial == trial]
+            held += sum(s is None for s in ready)
+            runnable = [s for s in ready if s is not None]
+            for record in _stream(config, runnable, run_dir, max_concurrent_llm, max_retries, start_method):
+                if interrupted():  # Ctrl-C that native code turned into an ordinary error: not a result
+                    raise KeyboardInterrupt
+                writer.append(record)
+                records.append(record)
+                done, successes, errors = done + 1, successes + record.success, errors + (record.error is not None)
+                bar.update(bar_id, advance=1, **fields())
+    if held:
+        console.print(
+            f"{held} trial(s) wait for an earlier trial of their world that has no result yet (a retryable error): "
+            "run them with --resume --retry-errors",
+            style="yellow",
+            markup=False,
+            highlight=False,
+        )
     return records
+
+
+def _stream(
+    config: RunConfig,
+    todo: Sequence[EpisodeSpec],
+    run_dir: Path,
+    max_concurrent_llm: int | None,
+    max_retries: int,
+    start_method: str,
+) -> Iterable[EpisodeRecord]:
+    """The records of ``todo`` as they finish: on Ray, in a process pool, or in this process (``config``)."""
+    if not todo:
+        return []
+    if config.ray_address:
+        from more_agent.eval.ray_backend import iter_ray
+
+        return iter_ray(
+            todo,
+            fn_path=config.episode_fn,
+            run_dir=run_dir,
+            address=config.ray_address,
+            max_concurrent_llm=max_concurrent_llm,
+            max_retries=max_retries,
+        )
+    if config.workers > 1 and len(todo) > 1:
+        return iter_processes(
+            todo,
+            fn_path=config.episode_fn,
+            run_dir=run_dir,
+            workers=config.workers,
+            start_method=start_method,
+            max_concurrent_llm=max_concurrent_llm,
+            max_retries=max_retries,
+        )
+    return iter_inline(todo, fn_path=config.episode_fn, run_dir=run_dir)

@@ -16,9 +16,19 @@ from typing import NamedTuple
 
 from more_agent.errors import UserError
 from more_agent.eval.failure import CAUSE_ORDER, cause_counts
-from more_agent.eval.metrics import METRIC_NAMES, Estimate, MetricSummary, by_system, by_task, group_by, system_label
+from more_agent.eval.metrics import (
+    METRIC_NAMES,
+    Estimate,
+    MetricSummary,
+    by_system,
+    by_task,
+    group_by,
+    summarize,
+    system_label,
+    wilson_interval,
+)
 from more_agent.eval.store import EPISODES_FILE, read_records
-from more_agent.records import EpisodeRecord
+from more_agent.records import EpisodeRecord, FailureReason
 from more_agent.redaction import for_terminal
 
 SUMMARY_MD = "summary.md"
@@ -38,9 +48,9 @@ class SourcedRecord(NamedTuple):
 def load_runs(run_dirs: Sequence[Path]) -> tuple[list[SourcedRecord], int]:
     """Records of several runs merged, and how many duplicates were dropped (first run wins).
 
-    Duplicates are records with the same (task, scene, seed, planner, llm).
+    Duplicates are records with the same (task, scene, seed, planner, trial, llm).
     """
-    seen: set[tuple[str, str, int, str, str | None]] = set()
+    seen: set[tuple[str, str, int, str, int, str | None]] = set()
     out: list[SourcedRecord] = []
     dropped = 0
     for d in map(Path, run_dirs):
@@ -109,6 +119,54 @@ def failure_markdown(records: Sequence[EpisodeRecord]) -> str:
     return _md_table(header, rows)
 
 
+def llm_markdown(records: Sequence[EpisodeRecord]) -> str:
+    """LLM traffic per system with an LLM: calls, tokens, and the share of steps whose answer stayed invalid
+    after its re-asks (an ``invalid`` action, reason ``invalid_answer``)."""
+    header = ["System", "n", "LLM calls", "calls / episode", "prompt tokens", "completion tokens", "reasoning tokens"]
+    header.append("invalid answers [% of steps]")
+    rows = []
+    for k, group in group_by((r for r in records if r.llm), system_label).items():
+        usage = [r.llm_usage for r in group]
+        steps = [a for r in group for a in r.actions]
+        invalid = sum(a.reason is FailureReason.INVALID_ANSWER for a in steps)
+        calls = sum(u.calls for u in usage)
+        rows.append(
+            [
+                k,
+                str(len(group)),
+                str(calls),
+                f"{calls / len(group):.1f}",
+                str(sum(u.prompt_tokens for u in usage)),
+                str(sum(u.completion_tokens for u in usage)),
+                str(sum(u.reasoning_tokens for u in usage)),
+                f"{100 * invalid / len(steps):.1f} ({invalid}/{len(steps)})" if steps else NO_VALUE,
+            ]
+        )
+    return _md_table(header, rows)
+
+
+def trials_markdown(records: Sequence[EpisodeRecord]) -> str:
+    """SR and TP per system and trial (``eval --trials``; trials count from 0), and per system the share of
+    worlds (task, scene, seed) that some trial solved ('any')."""
+    header = ["System", "trial", "n", "SR [%]", "TP [%]"]
+    rows = []
+    for k, group in group_by(records, system_label).items():
+        for trial, recs in sorted(group_by(group, lambda r: f"{r.trial:06d}").items()):
+            s = summarize(recs)
+            rows.append([k, str(int(trial)), str(s.n), fmt(s.SR), fmt(s.TP)])
+        worlds = group_by(group, lambda r: f"{r.task}|{r.scene}|{r.seed}")
+        solved = [any(r.success for r in w) for w in worlds.values()]
+        low, high = wilson_interval(sum(solved), len(solved))
+        any_sr = Estimate(mean=sum(solved) / len(solved), low=low, high=high, n=len(solved), method="wilson")
+        rows.append([k, "any", str(len(solved)), fmt(any_sr), ""])
+    return _md_table(header, rows)
+
+
+def has_trials(records: Sequence[EpisodeRecord]) -> bool:
+    """Whether ``records`` hold more than one trial of a world."""
+    return any(r.trial > 0 for r in records)
+
+
 TABLE_I_CAVEATS = (
     "Where this setting differs from the paper's (docs/evaluation.md): the VLM of the BUMBLE rows sees our "
     "renderer's flat-shaded boxes, each category in a colour from a hash of its name, not OmniGibson's "
@@ -132,6 +190,8 @@ def summary_markdown(records: Sequence[EpisodeRecord], *, title: str = "Evaluati
                 "conditions that name an observed task object; an episode that observed none has no rTP and "
                 "leaves its mean (its n is then given).",
                 TABLE_I_CAVEATS,
+                *(["## Trials", trials_markdown(records)] if has_trials(records) else []),
+                *(["## LLM traffic", llm_markdown(records)] if any(r.llm for r in records) else []),
                 "## Failure causes",
                 failure_markdown(records),
                 "## Per task",

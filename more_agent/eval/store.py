@@ -64,6 +64,11 @@ class RunConfig(BaseModel):
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode of every episode: 'gt' or 'noisy[:KEY=VALUE,...]'."
     )
+    trials: int = Field(default=1, ge=1, description="Trials of every (task, seed) world, run in sequence.")
+    long_term_memory: bool = Field(
+        default=False,
+        description="Give each trial the failure summaries its world's earlier trials left (BUMBLE's --add_past).",
+    )
     episode_fn: str = Field(description="Dotted path of the episode function.")
     workers: int = Field(default=1, description="Local worker processes (ignored with Ray).")
     ray_address: str | None = Field(default=None, description="Ray cluster address, or None for processes.")
@@ -85,6 +90,8 @@ MIXING_FIELDS = (
     "descriptions",
     "history",
     "perception",
+    "trials",
+    "long_term_memory",
     "episode_fn",
 )
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
@@ -114,6 +121,8 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
             "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
             "tasks": sorted({r.task for r in records} | set(config.tasks)),
             "seeds": sorted({r.seed for r in records} | set(config.seeds)),
+            "trials": max(config.trials, 1 + max(r.trial for r in records)),
+            "long_term_memory": any(r.long_term_memory for r in records),
         }
     )
 
@@ -248,20 +257,41 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
 
 
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
-    """The specs with no record yet, in order: a record counts for a spec when it shares task, seed,
-    planner, LLM, start, description mode, history, perception and distractors (a record that predates the distractors
-    field matches either) and scene (a record of a scene file's scene counts for the file)."""
-    done: dict[tuple[str, int, str, str | None, str, str, str, str], list[EpisodeRecord]] = {}
+    """The specs with no record yet, in order (a record counts for a spec when it is :func:`of_spec`)."""
+    done: dict[tuple[object, ...], list[EpisodeRecord]] = {}
     for r in records:
-        key = (r.task, r.seed, r.planner, r.llm, r.start, r.descriptions, r.history, r.perception)
-        done.setdefault(key, []).append(r)
-    out = []
-    for s in specs:
-        key = (s.task, s.seed, s.planner, s.llm, s.start, s.descriptions, s.history, s.perception)
-        scenes = {r.scene for r in done.get(key, []) if r.distractors in (None, s.distractors)}
-        if not scenes or (s.scene is not None and not {s.scene, _scene_name(s.scene)} & scenes):
-            out.append(s)
-    return out
+        done.setdefault(_match_key(r), []).append(r)
+    return [s for s in specs if not any(of_spec(r, s) for r in done.get(_match_key(s), []))]
+
+
+def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> bool:
+    """Whether ``record`` is an episode of ``spec``: same task, seed, planner, LLM, start, description mode,
+    history, perception, memory, distractors (a record that predates the distractors field matches either) and
+    scene (a record of a scene file's scene counts for the file); and, unless ``trial`` is False, the same trial."""
+    if _match_key(record) != _match_key(spec) or (trial and record.trial != spec.trial):
+        return False
+    if record.distractors not in (None, spec.distractors):
+        return False
+    return spec.scene is None or record.scene in {spec.scene, _scene_name(spec.scene)}
+
+
+def _match_key(x: EpisodeRecord | EpisodeSpec) -> tuple[object, ...]:
+    """What a record shares with its spec beside scene, distractors and trial (:func:`of_spec`)."""
+    return (x.task, x.seed, x.planner, x.llm, x.start, x.descriptions, x.history, x.perception, x.long_term_memory)
+
+
+def with_past_failures(spec: EpisodeSpec, records: list[EpisodeRecord]) -> EpisodeSpec | None:
+    """``spec`` given the long-term memory its world's earlier trials left in ``records`` (the failure
+    summaries of trials 0 .. spec.trial - 1, in trial order); None while one of those trials has no
+    result yet (no record, or a retryable error that ``--retry-errors`` will run again). Without
+    ``long_term_memory`` (or for trial 0) ``spec`` as it is."""
+    if not spec.long_term_memory or spec.trial == 0:
+        return spec
+    earlier = {r.trial: r for r in records if r.trial < spec.trial and of_spec(r, spec, trial=False)}
+    if len(earlier) < spec.trial or any(r.retryable for r in earlier.values()):
+        return None
+    past = tuple(s for t in sorted(earlier) for s in earlier[t].failure_summaries)
+    return spec.model_copy(update={"past_failures": past})
 
 
 @functools.cache
@@ -289,14 +319,17 @@ def episode_dirname(
     descriptions: str = "named",
     history: str = "paper",
     perception: str = "gt",
+    long_term_memory: bool = False,
+    trial: int = 0,
 ) -> str:
     """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
 
     The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
-    a history other than 'paper' and a perception other than 'gt' are part of the name, so that the
-    episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a folder.
+    a history other than 'paper', a perception other than 'gt' and the long-term memory are part of the name,
+    so that the episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a
+    folder; so is a trial other than the first (``t1`` is the second).
     """
-    parts = [task, scene or "auto", f"s{seed}", planner]
+    parts = [task, scene or "auto", f"s{seed}" + (f"t{trial}" if trial else ""), planner]
     if llm is not None:
         parts.append(llm if len(llm) <= 60 else f"{llm[:40]}-{hashlib.sha256(llm.encode()).hexdigest()[:8]}")
     if start != "random":
@@ -309,6 +342,8 @@ def episode_dirname(
         parts.append(f"{history}-history")
     if perception != "gt":
         parts.append(perception_part(perception))
+    if long_term_memory:
+        parts.append("memory")
     return re.sub(r"[^A-Za-z0-9_.\-]", "_", "__".join(parts))
 
 
@@ -325,6 +360,7 @@ def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str 
         scene if scene is not None else episode.scene,
         episode.seed,
         episode.planner,
+        trial=episode.trial,
         **episode_settings(episode),
     )
     return Path(run_dir) / EPISODE_DIRS / name

@@ -52,9 +52,16 @@ def free_text_chars(max_tokens: int, fields: int = 1) -> int:
 def bounded_schema(schema: Any, max_tokens: int = DEFAULT_MAX_TOKENS) -> Any:
     """A copy of ``schema`` with ``maxLength`` on unbounded strings and ``maxItems`` on unbounded arrays;
     free text gets its share of an answer of ``max_tokens`` tokens."""
-    properties = schema.get("properties", {}) if isinstance(schema, dict) else {}
-    free = sum(1 for name in properties if name in FREE_TEXT_FIELDS)
-    return _bounded(schema, "", free_text_chars(max_tokens, free))
+    return _bounded(schema, "", free_text_chars(max_tokens, _free_fields(schema)))
+
+
+def _free_fields(schema: Any) -> int:
+    """Free-text fields of one answer: of the schema's properties, or for a union of answer shapes
+    (:func:`~more_agent.llm.name_enums.per_skill_answer`) of the shape in ``$defs`` that has most."""
+    if not isinstance(schema, dict):
+        return 0
+    shapes = [schema, *schema.get("$defs", {}).values()]
+    return max(sum(name in FREE_TEXT_FIELDS for name in s.get("properties", {})) for s in shapes)
 
 
 def _bounded(schema: Any, field: str, text_chars: int) -> Any:

@@ -6,6 +6,9 @@
   ``max_tokens`` cuts it off all the same: logged as a warning).
 - The chat template is the GGUF's own (``tokenizer.chat_template``), never a guessed format; a file
   without one is refused with a clear error.
+- Text only: a message's images (the VLM planners' frames) are replaced by :data:`IMAGE_PLACEHOLDER`
+  in its text (:func:`text_only`), with a warning once per process, since the GGUF chat templates
+  take text (SmolLM2 has no vision); the model then reads the captions and object lists alone.
 - The context limit is ``min(llamacpp_n_ctx, the model's training context)``. A prompt whose tokens
   plus the answer budget (``max_tokens``) exceed it raises :class:`ContextLimitExceeded` before any
   generation, instead of llama.cpp silently shortening the answer.
@@ -35,6 +38,26 @@ CHAT_TEMPLATE_KEY = "tokenizer.chat_template"
 """GGUF metadata key of the model's chat template."""
 GGUF_CHAT_FORMAT = "chat_template.default"
 """llama-cpp-python's name for the chat handler built from the GGUF's template."""
+IMAGE_PLACEHOLDER = "[image not shown: this model reads text only]"
+"""What stands in a message's text for each image it carried."""
+
+
+def text_only(messages: Sequence[ChatMessage]) -> list[ChatMessage]:
+    """``messages`` with every content given as parts (text and images) made one text, each image a placeholder."""
+    out = []
+    for m in messages:
+        content = m["content"]
+        if not isinstance(content, str):
+            if any(part["type"] != "text" for part in content):
+                _warn_images_dropped()
+            content = "\n".join(p["text"] if p["type"] == "text" else IMAGE_PLACEHOLDER for p in content)
+        out.append(ChatMessage(role=m["role"], content=content))
+    return out
+
+
+@functools.cache
+def _warn_images_dropped() -> None:
+    log.warning("the llama.cpp model reads text only: the images of VLM requests are left out (%s)", IMAGE_PLACEHOLDER)
 
 
 def _import_llama_cpp() -> Any:
@@ -141,7 +164,7 @@ class LlamaCppBackend:
                 eos_token=_token_text(llm, llm.token_eos()),
                 bos_token=_token_text(llm, llm.token_bos()),
             )
-        rendered = self._formatter(messages=list(messages))
+        rendered = self._formatter(messages=text_only(messages))
         return len(llm.tokenize(rendered.prompt.encode("utf-8"), add_bos=not rendered.added_special, special=True))
 
     def generate(self, request: ChatRequest) -> Generation:
@@ -166,7 +189,7 @@ class LlamaCppBackend:
         if request.seed is not None:
             extra["seed"] = request.seed
         out = self.llama().create_chat_completion(
-            messages=list(request.messages),
+            messages=text_only(request.messages),
             temperature=request.temperature,
             max_tokens=request.max_tokens,
             **extra,

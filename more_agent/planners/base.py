@@ -87,6 +87,8 @@ class EpisodeContext:
     """LLM spec such as 'openai:gpt-4o', for planners that need one."""
     history: HistoryMode = DEFAULT_HISTORY
     """Which action history the LLM and VLM planners show (``more_agent.llm.prompts.history_text``)."""
+    past_failures: tuple[str, ...] = ()
+    """Long-term memory: failure summaries that earlier trials of the task left (BUMBLE's --add_past)."""
     trace_graphs: bool = False
     """Whether each step's trace must carry the scene graph (``--save-graph``, ``--viewer``): a planner
     that does not plan on one builds it only then."""

@@ -11,9 +11,9 @@ the planner reasons over images instead of a scene text.
 - **Frame buffer**: every rendered frame is offered to a :class:`VisualMemory` buffer (one frame per
   0.5 m or 30 degrees, the initial turn included), for the landmark and exploration questions.
 - **BUMBLE's memories** (:mod:`~more_agent.planners.bumble_memory`): short-term, the episode's steps
-  each with the annotated view seen then (downscaled, the last eight with images); long-term, failure
-  summaries of earlier trials of the task from the file ``$MORE_AGENT_BUMBLE_MEMORY`` names (each
-  failed step is appended to it).
+  each with the annotated view seen then (downscaled, the last eight with images); long-term, the failure
+  summaries of earlier trials of the task it is given (``EpisodeContext.past_failures``); each failed
+  step adds one to ``failure_summaries``, which the episode record keeps for the next trial.
 - **Deciding**: the VLM gets the task, the current view annotated set-of-mark style with its marked
   objects listed (with their distance from the robot, as BUMBLE's selector gets them), the memories
   and the skills, analyses step by step (whether the object is within reach included) and answers a
@@ -54,7 +54,6 @@ from more_agent.llm.name_enums import constrains_names, with_name_enums
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.bumble_memory import (
-    FailureStore,
     PastStep,
     downscaled_png,
     failure_summary,
@@ -159,10 +158,10 @@ class BumblePlanner(MappingSession):
         self.history_mode: HistoryMode = DEFAULT_HISTORY
         self.past: list[PastStep] = []
         """Short-term memory: the episode's steps with their views."""
-        self.store = FailureStore.from_env()
-        """Long-term memory file, if one is configured."""
         self.long_term: list[str] = []
         """Failure summaries of earlier trials of the task."""
+        self.failure_summaries: list[str] = []
+        """What this episode leaves for the later trials: a summary of each failed step."""
         self.feedback = ""
         self.graph: SceneGraph | None = None
         self.descriptions: dict[str, str] = {}
@@ -186,8 +185,8 @@ class BumblePlanner(MappingSession):
         self.body.on_frame = on_frame
         self.task = context.goal.text
         self.history, self.feedback, self.history_mode = [], "", context.history
-        self.past = []
-        self.long_term = self.store.summaries(self.task) if self.store is not None else []
+        self.past, self.failure_summaries = [], []
+        self.long_term = list(context.past_failures)
         self.calls.new_episode()
         self.body.start()
 
@@ -227,13 +226,13 @@ class BumblePlanner(MappingSession):
         return result
 
     def _remember(self, action: Step, done: ActionRecord) -> None:
-        """The step into the short-term memory; a failure also into the long-term memory file."""
+        """The step into the short-term memory; a failure also into what the long-term memory keeps."""
         view = self.step_log.pictures.get("view")
         subtask = action.note if action.name != INVALID else ""
         step = PastStep(subtask, action.name, done.ok, done.feedback, downscaled_png(view) if view else None)
         self.past.append(step)
-        if not step.ok and self.store is not None:
-            self.store.add(self.task, failure_summary(step))
+        if not step.ok:
+            self.failure_summaries.append(failure_summary(step))
 
     def step_trace(self) -> StepTrace:
         """The step's action, subtask, the frames offered and picked (its ``steps.jsonl`` line) and the VLM's images."""

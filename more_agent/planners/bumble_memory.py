@@ -8,12 +8,13 @@
   one per earlier step, bounded by its episode length; our episodes run longer); older steps keep
   their text.
 - **Long-term memory** (BUMBLE's ``--add_past``): summaries of failed skill executions of earlier
-  trials, loaded from a file and put before the episode's history. BUMBLE keeps failed selections
-  only; so does this store. A :class:`FailureStore` is a JSON Lines file (one ``{"task", "summary"}``
-  per line, appended as failures happen, so nothing written is lost when a run stops); the next run
-  of the same task description, pointed at the same file, reads them back. Where the file is:
-  ``$MORE_AGENT_BUMBLE_MEMORY`` (or ``--bumble-memory`` on ``more-agent run``); unset means no
-  long-term memory, as BUMBLE without ``--add_past``.
+  trials, put before the episode's history. BUMBLE keeps failed selections only; so does this memory.
+  The planner is given them (``EpisodeContext.past_failures``) and leaves its own in its record
+  (``failure_summaries``), so the trials' records are the memory: ``more-agent eval --trials N
+  --long-term-memory`` gives trial k those of trials 0 .. k-1 of its world. Across separate
+  ``more-agent run`` invocations a :class:`FailureStore` carries them instead: a JSON Lines file (one
+  ``{"task", "summary"}`` per line, the task's name) read before the episode and appended to after it
+  (``--bumble-memory PATH``). Without either there is no long-term memory, as BUMBLE without ``--add_past``.
 
 Written from the paper and the public code's behaviour, not copied.
 """
@@ -22,7 +23,6 @@ from __future__ import annotations
 
 import io
 import json
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,9 +40,6 @@ HISTORY_IMAGE_PX = 128
 
 LONG_TERM_SUMMARIES = 5
 """Most failure summaries of earlier trials put into one request (the most recent ones)."""
-
-ENV_MEMORY = "MORE_AGENT_BUMBLE_MEMORY"
-"""Environment variable naming the long-term memory file (JSON Lines)."""
 
 MAX_MEMORY_BYTES = 4_000_000
 """Largest long-term memory file read."""
@@ -119,16 +116,10 @@ def failure_summary(step: PastStep) -> str:
 
 
 class FailureStore:
-    """The long-term memory file: failure summaries per task description (module docstring)."""
+    """The long-term memory file of ``more-agent run --bumble-memory``: failure summaries per task (module docstring)."""
 
     def __init__(self, path: Path) -> None:
         self.path = path
-
-    @classmethod
-    def from_env(cls) -> FailureStore | None:
-        """The store ``$MORE_AGENT_BUMBLE_MEMORY`` names, or None."""
-        value = os.environ.get(ENV_MEMORY)
-        return cls(Path(value)) if value else None
 
     def summaries(self, task: str) -> list[str]:
         """The summaries stored for ``task``, oldest first; none when the file does not exist yet.
@@ -151,7 +142,9 @@ class FailureStore:
                 out.append(summary)
         return out
 
-    def add(self, task: str, summary: str) -> None:
-        """Append one summary (the file and its folder are created when missing)."""
+    def add(self, task: str, summaries: Sequence[str]) -> None:
+        """Append an episode's summaries in one write (the file and its folder are created when missing)."""
+        if not summaries:
+            return
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        append_text(self.path, json.dumps({"task": task, "summary": summary}) + "\n")
+        append_text(self.path, "".join(json.dumps({"task": task, "summary": s}) + "\n" for s in summaries))

@@ -50,7 +50,12 @@ from more_agent.llm import (
     room_spec,
 )
 from more_agent.llm.limits import MAX_NAME_CHARS, clip
-from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, with_name_enums
+from more_agent.llm.name_enums import (
+    constrains_names,
+    constrains_positions,
+    filter_answer_with_names,
+    with_name_enums,
+)
 from more_agent.mapping import MappingConfig
 from more_agent.planners.base import EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.exchanges import CallLog, RecordingClient
@@ -183,7 +188,10 @@ class LLMPlanner(MappingSession):
         view = self._view()
         planning_view = self.planning_view = self._filter(view) if self.config.filtering else view
         state = PlanState(self.task, self._graph(), view, planning_view, self.history, self.feedback, self.history_mode)
-        request = plan_request(self.config.prompt, state, name_enums=constrains_names(self.clients.plan))
+        plan = self.clients.plan
+        request = plan_request(
+            self.config.prompt, state, name_enums=constrains_names(plan), by_position=constrains_positions(plan)
+        )
         self.planning_scene = request.scene
         try:
             answer = ask_validated(

@@ -17,7 +17,7 @@ from pydantic import BaseModel
 from more_agent.llm import PlanAnswer, PlannedAction, parse_plan_answer, plan_messages, render_prompt
 from more_agent.llm.answers import MomaPlanAnswer
 from more_agent.llm.completion import ChatMessage
-from more_agent.llm.name_enums import with_name_enums
+from more_agent.llm.name_enums import per_skill_answer, with_name_enums
 from more_agent.planners.language import SceneView
 from more_agent.planners.moma_encoding import moma_history, moma_scene, without_state
 from more_agent.records import ActionRecord, HistoryMode
@@ -55,9 +55,15 @@ class PlanState:
 
 
 def plan_request(
-    kind: PromptKind, state: PlanState, *, name_enums: bool, skills: Sequence[Skill] = SKILLS
+    kind: PromptKind,
+    state: PlanState,
+    *,
+    name_enums: bool,
+    by_position: bool = False,
+    skills: Sequence[Skill] = SKILLS,
 ) -> PlanRequest:
-    """The planning call of prompt ``kind``; with ``name_enums`` its schema enumerates the valid names."""
+    """The planning call of prompt ``kind``; with ``name_enums`` its schema enumerates the valid names, with
+    ``by_position`` too per skill and argument position (a room where the skill table has a room...)."""
     rooms, objects = [r.name for r in state.view.rooms], state.view.object_names()
     if kind == "moma":
         scene = moma_scene(state.graph, state.planning_view).text()
@@ -76,7 +82,9 @@ def plan_request(
             skills=skills,
         )
         schema = PlanAnswer
-    if name_enums:
+    if name_enums and by_position:
+        schema = per_skill_answer(schema, skills, {"room": rooms, "object": objects})
+    elif name_enums:
         schema = with_name_enums(schema, {"skill": [s.name for s in skills], "arguments": rooms + objects})
 
     def validate(answer: str | Mapping[str, Any]) -> PlannedAction:

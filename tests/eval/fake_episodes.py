@@ -100,3 +100,19 @@ def swallowing_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> Epi
     except KeyboardInterrupt:
         raise RuntimeError("error in a native callback") from None
     return deterministic_episode(spec, out_dir=out_dir)
+
+
+def remembering_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """``deterministic_episode`` of the spec's trial that fails in trial 0 of tasks named 'flaky*' (a retryable
+    error), leaves one failure summary and shows the long-term memory it was given as its description."""
+    if spec.task.startswith("flaky") and spec.trial == 0 and os.environ.get("FAKE_FLAKY") == "1":
+        return EpisodeRecord.for_spec(spec, error="LLM error: timeout", error_kind="llm", retryable=True)
+    record = deterministic_episode(spec, out_dir=out_dir)
+    return record.model_copy(
+        update={
+            "trial": spec.trial,
+            "long_term_memory": spec.long_term_memory,
+            "description": " | ".join(spec.past_failures),
+            "failure_summaries": [f"{spec.task} s{spec.seed} trial {spec.trial} failed"],
+        }
+    )

@@ -15,7 +15,7 @@ import pytest
 
 from more_agent.errors import UserError
 from more_agent.eval.harness import config_specs, evaluate, resolve_tasks
-from more_agent.eval.store import RunConfig, read_records
+from more_agent.eval.store import RunConfig, episode_dir, read_records
 from more_agent.eval.worker import resolve_episode_fn
 from more_agent.records import EpisodeRecord
 from tests.eval import fake_episodes
@@ -165,3 +165,44 @@ def test_missing_ray_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "ray", None)
     with pytest.raises(UserError, match=r"more-agent\[ray\]"):
         import_ray()
+
+
+def test_trials_run_in_sequence_and_carry_their_failures(tmp_path: Path) -> None:
+    """--trials 3 --long-term-memory: trial k of a world is given the summaries of its trials 0 .. k-1 (from
+    their records), every record says its trial, and each trial has its own episode folder."""
+    cfg = config("remembering_episode", ["a", "b"], seeds=2, workers=2).model_copy(
+        update={"trials": 3, "long_term_memory": True}
+    )
+    records = evaluate(cfg, tmp_path / "run", show_progress=False)
+    assert sorted(r.key() for r in records) == sorted(
+        (t, "Rs_int", s, "oracle", k) for t in "ab" for s in (0, 1) for k in range(3)
+    )
+    for r in records:
+        assert r.description == " | ".join(f"{r.task} s{r.seed} trial {k} failed" for k in range(r.trial))
+    assert [r.trial for r in records] == sorted(r.trial for r in records)  # trial-major: rounds
+    assert {s.trial for s in config_specs(cfg)} == {0, 1, 2}
+    assert len({episode_dir(tmp_path / "run", r) for r in records}) == 12
+
+    no_memory = evaluate(cfg.model_copy(update={"long_term_memory": False}), tmp_path / "plain", show_progress=False)
+    assert all(r.description == "" for r in no_memory)
+
+
+def test_a_trial_waits_for_the_retried_error_of_its_earlier_trial(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A retryable error in trial 0 holds trial 1 of that world back (its memory is not known yet); resume with
+    --retry-errors runs both, and trial 1 then remembers the rerun trial 0."""
+    cfg = config("remembering_episode", ["flaky", "ok"]).model_copy(update={"trials": 2, "long_term_memory": True})
+    monkeypatch.setenv("FAKE_FLAKY", "1")
+    first = evaluate(cfg, tmp_path / "run", show_progress=False)
+    assert sorted((r.task, r.trial, r.retryable) for r in first) == [
+        ("flaky", 0, True),
+        ("ok", 0, False),
+        ("ok", 1, False),
+    ]
+    monkeypatch.setenv("FAKE_FLAKY", "0")
+    after = evaluate(cfg, tmp_path / "run", resume=True, retry_errors=True, show_progress=False)
+    flaky = {r.trial: r for r in after if r.task == "flaky"}
+    assert sorted(flaky) == [0, 1] and not flaky[0].error
+    assert flaky[1].description == "flaky s0 trial 0 failed"
+    assert len(read_records(tmp_path / "run")) == 4

@@ -44,7 +44,7 @@ def test_roundtrip_one_line_per_record(tmp_path: Path) -> None:
     p = tmp_path / "episodes.jsonl"
     write(p, [rec("a"), rec("b", 1)])
     assert p.read_text().count("\n") == 2
-    assert [r.key() for r in read_records(p)] == [("a", "Rs_int", 0, "oracle"), ("b", "Rs_int", 1, "oracle")]
+    assert [r.key() for r in read_records(p)] == [("a", "Rs_int", 0, "oracle", 0), ("b", "Rs_int", 1, "oracle", 0)]
     assert read_records(tmp_path) == read_records(p)
     assert read_records(tmp_path / "missing.jsonl") == []
 

@@ -57,3 +57,14 @@ def test_cache_key_covers_the_image_bytes_and_replay_works(fake_openai: FakeOpen
     stored = sqlite3.connect(llm_config.cache_path).execute("SELECT request FROM responses").fetchall()
     for (request,) in stored:
         assert "base64" not in request and "sha256:" in json.loads(request)["messages"][0]["content"][1]["image_url"]["url"]
+
+
+def test_llamacpp_requests_carry_text_with_a_placeholder_per_image() -> None:
+    """GGUF chat templates take text: a VLM request reaches llama.cpp as its text, each image marked as left out."""
+    from more_agent.llm.llamacpp_backend import IMAGE_PLACEHOLDER, text_only
+
+    png = png_bytes(np.zeros((4, 4, 3), dtype=np.uint8))
+    messages = [ChatMessage(role="system", content="You see."),
+                ChatMessage(role="user", content=[text_part("Current view:"), image_part(png), text_part("1: fridge A")])]
+    system, user = text_only(messages)
+    assert system == messages[0] and user == {"role": "user", "content": f"Current view:\n{IMAGE_PLACEHOLDER}\n1: fridge A"}

@@ -4,14 +4,23 @@ from __future__ import annotations
 
 import json
 
+import jsonschema
 import pytest
+from pydantic import ValidationError
 
-from more_agent.llm import ChatMessage, LLMConfig, PlanAnswer, ask_validated, make_client
+from more_agent.llm import CacheMode, ChatMessage, LLMConfig, PlanAnswer, ask_validated, make_client
 from more_agent.llm.answers import FilterAnswer, MomaPlanAnswer, RoomLabelAnswer
 from more_agent.llm.config import NameEnums, StructuredOutput
 from more_agent.llm.grammar import bounded_schema
 from more_agent.llm.jsontext import json_schema_of
-from more_agent.llm.name_enums import constrains_names, filter_answer_with_names, uses_name_enums, with_name_enums
+from more_agent.llm.name_enums import (
+    constrains_names,
+    constrains_positions,
+    filter_answer_with_names,
+    per_skill_answer,
+    uses_name_enums,
+    with_name_enums,
+)
 from more_agent.llm.parsing import parse_plan_answer
 from more_agent.llm.usage import reasoning_tokens
 from more_agent.skills import SKILLS
@@ -107,3 +116,67 @@ def test_filter_answers_enumerate_rooms_and_objects_in_their_nested_entries() ->
     assert filter_answer_with_names({}, []) is FilterAnswer
     room = json_schema_of(with_name_enums(RoomLabelAnswer, {"room": ["kitchen", "bathroom"]}))
     assert room["properties"]["room"]["enum"] == ["bathroom", "kitchen"]
+
+
+BY_KIND = {"room": ROOMS, "object": OBJECTS}
+
+
+def _shapes(schema: dict) -> dict[str, dict]:
+    """Skill name -> the properties of its answer shape in a per-skill union schema."""
+    shapes = [schema["$defs"][ref["$ref"].rsplit("/", 1)[1]]["properties"] for ref in schema["anyOf"]]
+    return {shape["skill"]["const"]: shape for shape in shapes}
+
+
+def test_per_skill_answers_constrain_each_argument_position() -> None:
+    """The skill table's parameter kinds by position: explore(room), go_to_and_grasp(room, object), done()."""
+    model = per_skill_answer(MomaPlanAnswer, SKILLS, BY_KIND)
+    schema = json_schema_of(model)
+    shapes = _shapes(schema)
+    assert sorted(shapes) == sorted(s.name for s in SKILLS) and schema["title"] == "MomaPlanAnswer"
+    assert all(list(p) == ["analysis", "reasoning", "skill", "arguments"] for p in shapes.values())
+    assert shapes["explore"]["arguments"]["prefixItems"] == [{"enum": ROOMS, "type": "string"}]
+    assert [i["enum"] for i in shapes["go_to_and_grasp"]["arguments"]["prefixItems"]] == [ROOMS, sorted(OBJECTS)]
+    assert shapes["done"]["arguments"]["maxItems"] == 0 and shapes["done"]["arguments"]["items"] == {"type": "string"}
+    jsonschema.Draft202012Validator.check_schema(schema)  # a valid schema (no empty prefixItems)
+    jsonschema.validate({"analysis": "", "reasoning": "", "skill": "done", "arguments": []}, schema)
+    valid = {"analysis": "", "reasoning": "", "skill": "go_to_and_grasp", "arguments": ["kitchen_0", "apple A"]}
+    model.model_validate(valid)
+    for wrong in (["apple A", "kitchen_0"], ["kitchen_0"], ["kitchen_0", "apple A", "sofa A"]):
+        with pytest.raises(ValidationError):
+            model.model_validate({**valid, "arguments": wrong})
+    with pytest.raises(ValidationError):
+        model.model_validate({**valid, "skill": "explore"})  # explore takes one room
+    early = _shapes(json_schema_of(per_skill_answer(PlanAnswer, SKILLS, {"room": ROOMS, "object": []})))
+    assert sorted(early) == ["done", "explore"]  # nothing seen yet: no skill on an object can be named
+
+
+def test_only_llamacpp_clients_get_positions() -> None:
+    assert constrains_positions(make_client("llamacpp:smollm2", LLMConfig(cache_mode=CacheMode.REPLAY)))
+    assert not constrains_positions(
+        make_client("llamacpp:smollm2", LLMConfig(cache_mode=CacheMode.REPLAY, name_enums=NameEnums.OFF))
+    )
+    on = LLMConfig(cache_mode=CacheMode.REPLAY, name_enums=NameEnums.ON)
+    assert constrains_names(make_client("openai:gpt-4o", on)) and not constrains_positions(
+        make_client("openai:gpt-4o", on)
+    )
+
+
+@pytest.mark.real_llm
+def test_the_per_skill_union_compiles_and_smollm2_answers_by_position() -> None:
+    """The union compiles to a GBNF grammar (one alternative per skill, each position its kind's names, done's
+    arguments empty), and SmolLM2 decoding with it answers an object where an object goes."""
+    from llama_cpp import llama_grammar
+
+    model = per_skill_answer(PlanAnswer, SKILLS, BY_KIND)
+    grammar = llama_grammar.json_schema_to_gbnf(json.dumps(bounded_schema(json_schema_of(model))))
+    rules = dict(line.split(" ::= ", 1) for line in grammar.splitlines() if " ::= " in line)
+    assert rules["root"].count("alternative-") == len(SKILLS)
+    assert rules["PlanAnswer-go-to-and-grasp-arguments-tuple-1"] == " | ".join(f'"\\"{o}\\""' for o in sorted(OBJECTS))
+    assert rules["PlanAnswer-done-arguments"] == '"[" space  "]" space'
+    client = make_client("llamacpp:smollm2", LLMConfig(cache_mode=CacheMode.OFF, max_tokens=256))
+    messages = [ChatMessage(role="user", content="Kitchen_0 has fridge A and apple A. Grasp apple A. Answer JSON.")]
+    answer = json.loads(client.complete(messages, schema=model, purpose="plan").text)
+    model.model_validate(answer)
+    skill = next(s for s in SKILLS if s.name == answer["skill"])
+    kinds = [ROOMS if k == "room" else OBJECTS for k in skill.params]
+    assert len(answer["arguments"]) == len(kinds) and all(a in k for a, k in zip(answer["arguments"], kinds))

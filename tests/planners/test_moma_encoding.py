@@ -25,12 +25,12 @@ HISTORY = [
 ]
 
 
-def _request(planner: str, *, name_enums: bool = False) -> PlanRequest:
+def _request(planner: str, *, name_enums: bool = False, by_position: bool = False) -> PlanRequest:
     config = PLANNER_CONFIGS[planner]
     graph = hand_made_graph()
     view = scene_view(graph, config.language)
     state = PlanState("Put the book on the sofa.", graph, view, view, HISTORY, "go_to_and_grasp: success", "paper")
-    return plan_request(config.prompt, state, name_enums=name_enums)
+    return plan_request(config.prompt, state, name_enums=name_enums, by_position=by_position)
 
 
 def _prompt_text(request: PlanRequest) -> str:
@@ -93,6 +93,23 @@ def test_name_enums_list_exactly_the_names_of_the_request() -> None:
     assert "fridge A" not in names and schema["additionalProperties"] is False
     more = _request("more", name_enums=True).schema.model_json_schema()["properties"]["arguments"]["items"]["enum"]
     assert "fridge A" in more and "fridge" not in more
+
+
+@pytest.mark.parametrize(("planner", "fridge"), [("more", "fridge A"), ("moma-llm", "fridge")])
+def test_plan_requests_by_position_name_a_room_then_an_object(planner: str, fridge: str) -> None:
+    """llama.cpp's form of the name enums: one answer shape per skill, each argument from its kind's names."""
+    request = _request(planner, name_enums=True, by_position=True)
+    schema = request.schema.model_json_schema()
+    shapes = {d["properties"]["skill"]["const"]: d["properties"] for d in schema["$defs"].values()}
+    rooms, objects = (p["enum"] for p in shapes["go_to_and_open"]["arguments"]["prefixItems"])
+    assert "kitchen_0" in rooms and fridge in objects and "kitchen_0" not in objects and fridge not in rooms
+    assert [p["enum"] for p in shapes["explore"]["arguments"]["prefixItems"]] == [rooms]
+    assert (
+        request.validate(
+            {"analysis": "", "reasoning": "", "skill": "go_to_and_open", "arguments": ["kitchen_0", fridge]}
+        ).call
+        == f"go_to_and_open(kitchen_0, {fridge})"
+    )
 
 
 def test_history_line_when_nothing_was_done() -> None:
