@@ -23,7 +23,7 @@ def _no_llm(monkeypatch: pytest.MonkeyPatch) -> None:
         monkeypatch.delenv(name, raising=False)
 
 
-def test_default_run_without_llm_says_so_first_and_solves_with_grounded(tmp_path: Path) -> None:
+def test_default_run_without_llm_says_so_first_and_solves_with_grounded(tmp_path: Path, pictures_on: None) -> None:
     result = runner.invoke(app, ["run", TASK, "--scene", "Rs_int", "--out", str(tmp_path), "--save-frames"])
     assert result.exit_code == 0, result.output
     assert result.output.splitlines()[0] == NO_LLM_MESSAGE

@@ -11,7 +11,7 @@ from more_agent.cli import app
 runner = CliRunner()
 
 
-def test_default_out_dir_names_task_scene_seed_planner(tmp_path, monkeypatch):
+def test_default_out_dir_names_task_scene_seed_planner(tmp_path, monkeypatch, pictures_on):
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("OPENAI_API_KEY", raising=False)
     result = runner.invoke(app, ["run", "putting_shopping_away", "--scene", "Rs_int", "--seed", "2", "--planner", "oracle"])

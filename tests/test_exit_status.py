@@ -149,7 +149,7 @@ def test_run_refuses_a_folder_of_another_episode_and_cleans_its_own(tmp_path: Pa
     assert code == 0 and not (ep / "steps.jsonl").exists(), text
 
 
-def test_no_file_is_written_through_a_symlink(tmp_path: Path) -> None:
+def test_no_file_is_written_through_a_symlink(tmp_path: Path, pictures_on: None) -> None:
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")
     ep = tmp_path / "ep"

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from more_agent.errors import UserError
+from more_agent.eval.pictures import pictures_enabled
 from more_agent.record_validation import parse_record, record_json
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.safe_files import append_text, make_dir, read_bounded, write_atomic
@@ -215,9 +216,10 @@ class EpisodeFolder:
     def write_map(
         self, record: EpisodeRecord, world: World | None, labels: InstanceLabels | None, labelled: Collection[str]
     ) -> None:
-        """The map picture (when the world was built); a picture that fails is logged, never costs the record."""
+        """The map picture (when the world was built and pictures are on, ``eval.pictures``); a picture that
+        fails is logged, never costs the record."""
         self.path.mkdir(parents=True, exist_ok=True)
-        if world is None or labels is None:
+        if world is None or labels is None or not pictures_enabled():
             return
         from more_agent.viz.trajectory import trajectory_map_png
 

@@ -290,10 +290,14 @@ def evaluate(
 
 
 def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeRecord]) -> int:
-    """Redraw the ``map.png`` of recorded episodes whose picture is missing or torn; return how many."""
+    """Redraw the ``map.png`` of recorded episodes whose picture is missing or torn (none while pictures are
+    off, ``eval.pictures``); return how many."""
     from more_agent.eval.episode import redraw_map
     from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
+    from more_agent.eval.pictures import pictures_enabled
 
+    if not pictures_enabled():
+        return 0
     by_key = {(r.task, r.seed, r.trial, r.planner, r.llm, r.start): r for r in records}
     redrawn = 0
     for spec in config_specs(config):

@@ -107,11 +107,20 @@ def draw_plan(
     ax.set_ylabel("y (m)")
 
 
+PLAN_MARGINS = (0.8, 0.55, 2.1, 0.4)
+"""Inches around the plan (left, bottom, right, top): tick labels and axis names, the legend on the right,
+the title. A fixed layout draws a figure once; ``bbox_inches="tight"`` drew it twice to crop it."""
+
+
 def plan_figure(scene: Scene) -> tuple[Figure, Axes]:
-    """A figure sized to the scene's aspect ratio (about 10 inches on its long side, plus a legend)."""
+    """A figure holding the plan at 7.5 inches on its long side, with fixed margins for labels and legend."""
     w, h = scene.bounds[2] - scene.bounds[0], scene.bounds[3] - scene.bounds[1]
-    scale = 10.0 / max(w, h)
-    return plt.subplots(figsize=(max(w * scale, 4) + 2.5, max(h * scale, 4)))
+    scale = 7.5 / max(w, h)
+    left, bottom, right, top = PLAN_MARGINS
+    aw, ah = w * scale, max(h * scale, 2.4)  # the legend's eleven rows need about 2.4 inches
+    fig = plt.figure(figsize=(left + aw + right, bottom + ah + top))
+    fw, fh = fig.get_size_inches()
+    return fig, fig.add_axes((left / fw, bottom / fh, aw / fw, ah / fh))
 
 
 def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture: bool = False) -> Path:
@@ -121,7 +130,6 @@ def plot_plan(scene: Scene, path: str | Path, *, dpi: int = 110, label_furniture
     try:
         draw_plan(ax, scene, label_furniture=label_furniture)
         ax.set_title(f"{scene.name} (seed {scene.seed})")
-        fig.tight_layout()
         fig.savefig(path, dpi=dpi)
     finally:
         plt.close(fig)

@@ -70,7 +70,7 @@ def trajectory_map_png(
         draw_trajectory(ax, trajectory)
         ax.set_title(title, fontsize=9)
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+        fig.savefig(buf, format="png", dpi=dpi)
         return buf.getvalue()
     finally:
         plt.close(fig)

@@ -3,18 +3,24 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
 from more_agent.errors import UserError
 from more_agent.eval.episode import run_episode
+from more_agent.eval.episode_folder import EpisodeFolder
+from more_agent.eval.pictures import ENV_PICTURES
 from more_agent.planners.base import DONE
-from more_agent.records import EpisodeSpec
+from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World
 
 SPEC = EpisodeSpec(task="putting_shopping_away", scene="Rs_int", seed=0, planner="oracle")
 
 
-def test_oracle_episode_record_fields_and_files(tmp_path):
+def test_oracle_episode_record_fields_and_files(tmp_path, pictures_on):
     record = run_episode(SPEC, out_dir=tmp_path)
     assert record.success and record.all_goals_met and record.done_called and record.error is None
     assert record.task_progress == 1.0 and record.goal_conditions and all(c.satisfied for c in record.goal_conditions)
@@ -49,3 +55,16 @@ def test_the_folder_holds_each_steps_trace_and_frames(tmp_path):
     frames = timeline[-1]["frames"]
     assert frames == len(list(folder.frames_dir.glob("frame_*_rgb.png"))) > record.high_level_steps
     assert folder.frame_path(frames - 1, "semantic").is_file() and not folder.frame_path(frames, "rgb").exists()
+
+
+def test_without_pictures_the_folder_draws_no_map(tmp_path, monkeypatch):
+    scene = load_scene(Path(__file__).parents[1] / "fixtures" / "tiny_scene.json")
+    world, labels = World.from_scene(scene), InstanceLabels()
+    record = EpisodeRecord(task="t", scene=scene.name, seed=0, planner="oracle", trajectory=[(1.0, 1.0), (2.0, 1.5)])
+    folder = EpisodeFolder(tmp_path)
+    monkeypatch.setenv(ENV_PICTURES, "0")
+    folder.write_map(record, world, labels, set())
+    assert not folder.map_path.exists()
+    monkeypatch.setenv(ENV_PICTURES, "1")
+    folder.write_map(record, world, labels, set())
+    assert folder.map_path.read_bytes()[:4] == b"\x89PNG"

@@ -121,7 +121,7 @@ class _Crashing(_Idle):
         raise RuntimeError("planner bug")
 
 
-def test_a_raising_planner_is_recorded_with_its_traceback(tmp_path: Path) -> None:
+def test_a_raising_planner_is_recorded_with_its_traceback(tmp_path: Path, pictures_on: None) -> None:
     record = run_episode(SPEC.model_copy(update={"planner": "crash"}), planner=_Crashing(), out_dir=tmp_path)
     assert record.error == "RuntimeError: planner bug" and "Traceback" in (record.traceback or "")
     assert record.error_kind == "crash" and record.termination is None
@@ -135,7 +135,7 @@ def test_unknown_task_is_recorded_not_raised() -> None:
 
 
 @pytest.mark.slow
-def test_resume_redraws_missing_and_torn_maps(tmp_path: Path) -> None:
+def test_resume_redraws_missing_and_torn_maps(tmp_path: Path, pictures_on: None) -> None:
     from more_agent.eval.episode_folder import MAP_FILE, map_is_complete
     from more_agent.eval.harness import evaluate
     from more_agent.eval.store import RunConfig

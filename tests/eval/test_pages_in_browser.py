@@ -50,7 +50,7 @@ def test_viewer_steps_with_the_arrow_keys_and_shows_llm_text_as_text(browser: Ch
 
 
 def test_oracle_viewer_and_report_load_without_errors(browser: Chromium, llm_episode: Episode, oracle_episode: Episode,
-                                                      tmp_path: Path) -> None:
+                                                      tmp_path: Path, pictures_on: None) -> None:
     page = browser.page
     page.goto(oracle_episode.dir / VIEWER_FILE)
     assert page.js("document.getElementById('llmdetail').style.display") == "none"

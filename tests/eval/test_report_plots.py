@@ -4,9 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from PIL import Image
 
+from more_agent.eval.pictures import ENV_PICTURES
+from more_agent.eval.report import REPORT_HTML, SUMMARY_CSV, SUMMARY_MD, SourcedRecord
 from more_agent.eval.report_plots import PLOT_FILES, failure_reason, write_plots
+from more_agent.eval.report_writer import write_reports
 from more_agent.records import EpisodeRecord, Failure, LLMUsage
 
 
@@ -35,3 +39,12 @@ def test_write_plots_draws_every_plot_even_with_missing_cells(tmp_path: Path) ->
         with Image.open(p) as im:
             assert im.format == "PNG" and im.width > 300 and im.height > 150
     assert write_plots([], tmp_path / "none") == []
+
+
+def test_reports_without_pictures_leave_the_plots_out(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(ENV_PICTURES, "off")
+    records = [rec("t1", "oracle", success=True, all_goals_met=True, task_progress=1.0, high_level_steps=7)]
+    paths = write_reports([SourcedRecord(r, tmp_path) for r in records], tmp_path / "report")
+    assert [p.name for p in paths] == [SUMMARY_MD, SUMMARY_CSV, REPORT_HTML] and all(p.is_file() for p in paths)
+    assert "## Plots" not in paths[0].read_text() and "plot_" not in paths[2].read_text()
+    assert not list((tmp_path / "report").glob("*.png"))
