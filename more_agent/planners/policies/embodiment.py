@@ -120,6 +120,12 @@ class Embodiment:
         return self.robot.trajectory
 
     @property
+    def mapped_m2(self) -> float:
+        """Floor area the robot's map knows (free or occupied), square metres: how much an explore showed."""
+        cell = self.builder.config.resolution_m
+        return float(np.count_nonzero(self.builder.voxels.top_class >= 0)) * cell * cell
+
+    @property
     def low_level_steps(self) -> int:
         """Low-level steps since the episode began (the robot's count)."""
         return self.robot.low_level_steps
