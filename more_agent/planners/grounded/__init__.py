@@ -16,7 +16,8 @@ Every step (MPC style) it rebuilds the scene graph and:
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place (on a floor the description names only once
-   a region of that room type is known: until then it searches), put down what the hand holds but
+   a region of that room type is known, or the region where it found what the description says stays
+   on that floor: until then it searches), put down what the hand holds but
    does not need (on the floor, or on low furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore; none when
