@@ -13,7 +13,7 @@ runner share the types.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 ROBOT_NAME = "robot"
 """The agent's name in goal literals over world names."""
@@ -54,6 +54,10 @@ class TaskGoal:
     """The agent's scope name."""
     moved: frozenset[str] = frozenset()
     """Scopes the goal moves (subjects of placement literals): only things that can be picked up are them."""
+    stays: dict[str, str] = field(default_factory=dict)
+    """Scope -> the floor scope the description says it stays on ("every carton stays on the garage floor",
+    "leave toolbox A on the garage floor"): a goal literal ``ontop`` a floor whose room the description
+    names that holds from the start. Where the robot finds the object is that room, whatever its furniture."""
 
     def is_floor(self, scope: str) -> bool:
         return scope in self.floor_rooms

@@ -14,8 +14,17 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 
 from more_agent.eval.termination import describe
-from more_agent.records import REACH_FAILURES, ActionRecord, EpisodeRecord, Failure, FailureCause, FailureReason
+from more_agent.records import (
+    REACH_FAILURES,
+    ActionRecord,
+    EpisodeRecord,
+    Failure,
+    FailureCause,
+    FailureReason,
+    GoalCondition,
+)
 from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.predicates import PREDICATES
 from more_agent.sim.world import World
 from more_agent.skills import SKILLS
 
@@ -59,7 +68,8 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
     if record.all_goals_met:
         return Failure(cause="done_not_called", detail=ended or "every goal condition held; done() never called")
     unmet = [c for c in record.goal_conditions if not c.satisfied]
-    needed = sorted({o for c in unmet for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
+    achievable = [c for c in unmet if is_modelled(c)]  # seeing or reaching the objects of the others changes nothing
+    needed = sorted({o for c in achievable for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     called = {o: labels.label(o) or o for o in needed}
     goal_objects = {o for c in record.goal_conditions for o in c.objects}
     wrong = _wrong_instances(record.actions, needed, goal_objects, world, labels)
@@ -90,6 +100,14 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
     if record.done_called:
         return Failure(cause="done_early", detail=record.gave_up or f"done() with {first_unmet} unmet")
     return Failure(cause="step_limit", detail=f"{ended or 'step limit'}; {first_unmet} unmet")
+
+
+def is_modelled(condition: GoalCondition) -> bool:
+    """Whether the world models the predicate of a goal condition (its bddl literal, ``(not (p ...))`` or
+    ``(p ...)``); no robot meets one it does not model (``attached``: docs/tasks.md)."""
+    words = condition.text.replace("(", " ").split()
+    predicate = words[1] if words[:1] == ["not"] and len(words) > 1 else words[0] if words else ""
+    return predicate in PREDICATES
 
 
 def _wrong_instances(

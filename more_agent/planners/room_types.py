@@ -45,6 +45,16 @@ def category_likelihood(category: str, room_type: str) -> float:
     return (counts.get(category, 0) + SMOOTHING) / (sum(counts.values()) + SMOOTHING * vocabulary)
 
 
+def listed_share(category: str, room_type: str) -> float:
+    """Share of ``room_type``'s listed objects that are ``category``; 0 when no scene lists it in such a room
+    (or the room type is unknown). Where to look for a missing piece: unlike :func:`category_likelihood`,
+    no smoothing, which would rank the room types with the shortest lists first for what none lists."""
+    counts = room_type_counts().get(room_type)
+    if not counts or not counts.get(category):
+        return 0.0
+    return counts[category] / sum(counts.values())
+
+
 def likely_room_type(categories: Iterable[str]) -> str | None:
     """The room type that best explains the furniture categories seen (naive Bayes, uniform prior);
     None when none of them is furniture any room type lists."""

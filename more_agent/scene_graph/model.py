@@ -15,6 +15,7 @@ robot holds at most one object.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from enum import Enum
 from typing import Annotated
 
@@ -172,6 +173,13 @@ class SceneGraph(_Model):
     def held_object(self) -> ObjectNode | None:
         """The object in the robot's hand, if any."""
         return next((o for o in self.objects.values() if o.held), None)
+
+    def without_room_labels(self, region_ids: Iterable[str]) -> SceneGraph:
+        """A copy with the room labels of the given regions taken away (to be typed again; unknown ids raise KeyError)."""
+        regions = dict(self.regions)
+        for rid in region_ids:
+            regions[rid] = regions[rid].model_copy(update={"room_label": None})
+        return self.model_copy(update={"regions": regions})
 
     def with_room_labels(self, labels: dict[str, str]) -> SceneGraph:
         """A copy with LLM room labels set on the given regions (unknown ids raise KeyError)."""

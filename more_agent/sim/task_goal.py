@@ -76,8 +76,30 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         if scope in described:
             named[scope] = instance.label(scope)
     return TaskGoal(
-        options=options, categories=categories, named=named, floor_rooms=floors, robot=robot, moved=frozenset(moved)
+        options=options,
+        categories=categories,
+        named=named,
+        floor_rooms=floors,
+        robot=robot,
+        moved=frozenset(moved),
+        stays=staying(options, floors, instance.definition.init),
     )
+
+
+def staying(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | None], init: list[Any]) -> dict[str, str]:
+    """Scope -> floor scope, for each goal literal ``(ontop scope floor)`` over a floor whose room the
+    description names that the task's init already states: the description says it stays there
+    (``TaskGoal.stays``)."""
+    initial = {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
+    return {
+        lit.args[0]: lit.args[1]
+        for option in options
+        for lit in option
+        if lit.predicate == "ontop"
+        and not lit.negated
+        and floors.get(lit.args[1]) is not None
+        and ("ontop", *lit.args) in initial
+    }
 
 
 def intended_goal(parsed: list[Any]) -> list[Any]:

@@ -105,3 +105,17 @@ def test_a_wrong_instance_names_a_needed_one_never_seen_by_its_world_name() -> N
     failure = classify_failure(_record(actions=[_act("go_to_and_place_inside", other, True)]), world, labels)
     assert failure is not None and failure.cause == "wrong_instance"
     assert failure.detail.endswith("the goal needs bottom_cabinet_0 (never observed)")
+
+
+def test_a_goal_the_world_cannot_meet_is_not_lost_to_what_was_never_seen(world: World, labels: InstanceLabels) -> None:
+    """attach_a_camera_to_a_tripod: ``attached`` is not modelled, so the planner calls done() at once; that
+    the camera was never seen explains nothing (docs/evaluation.md: done_early)."""
+    attached = GoalCondition(text="(attached canned_food_1 bottom_cabinet_0)", satisfied=False,
+                             objects=["canned_food_1", "bottom_cabinet_0"])
+    record = _record(goal_conditions=[attached], observed_objects=[], done_called=True, termination="done")
+    failure = classify_failure(record, world, labels)
+    assert failure is not None and failure.cause == "done_early"
+    negated = GoalCondition(text="(not (inside canned_food_1 bottom_cabinet_0))", satisfied=False,
+                            objects=["canned_food_1", "bottom_cabinet_0"])
+    failure = classify_failure(_record(goal_conditions=[negated], observed_objects=[]), world, labels)
+    assert failure is not None and failure.cause == "never_observed"  # a modelled predicate, negated

@@ -52,7 +52,9 @@ def looked_around() -> tuple[TaskInstance, Embodiment, SceneGraph]:
     return fresh()
 
 
-def test_look_around_is_a_full_turn_of_low_level_steps(looked_around: tuple[TaskInstance, Embodiment, SceneGraph]) -> None:
+def test_look_around_is_a_full_turn_of_low_level_steps(
+    looked_around: tuple[TaskInstance, Embodiment, SceneGraph],
+) -> None:
     inst, body, graph = looked_around
     assert body.low_level_steps == 11  # 360 deg in turns of at most 35 deg
     assert graph.objects and "fridge A" in graph.objects and inst.world.get("fridge_0").instance_id in body.observed
@@ -114,7 +116,9 @@ def test_explore_reaches_a_frontier_then_reports_none_left() -> None:
     assert result.reason is FailureReason.INVALID_TARGET and result.low_level_steps == 0
 
 
-def test_pick_target_prefers_what_the_skill_can_act_on(looked_around: tuple[TaskInstance, Embodiment, SceneGraph]) -> None:
+def test_pick_target_prefers_what_the_skill_can_act_on(
+    looked_around: tuple[TaskInstance, Embodiment, SceneGraph],
+) -> None:
     _, body, graph = looked_around
     opened = graph.objects["fridge A"].model_copy(update={"id": "fridge Z", "label": "fridge Z", "open": True})
     g = graph.model_copy(update={"objects": {**graph.objects, "fridge Z": opened}})
@@ -134,7 +138,9 @@ def test_agent_grid_blind_ring_bumps_and_goals_in_the_robots_component() -> None
     assert ring.is_free(1.05, 1.05)
     path, index = path_to_nearest(ring, (1.05, 1.05), [(2.9, 1.0)], snap_m=1.0)
     assert index == 0 and path.waypoints[-1][0] < 2.5  # snapped to this side of the wall, not beyond it
-    bumped = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=[(1.05, 1.05)], blind_radius_m=0.5, bumped_xy=[(1.6, 1.05)])
+    bumped = agent_nav_grid(
+        occupancy, inflation_m=0.25, stood_xy=[(1.05, 1.05)], blind_radius_m=0.5, bumped_xy=[(1.6, 1.05)]
+    )
     assert ring.is_free(1.6, 1.05) and not bumped.is_free(1.6, 1.05) and not bumped.is_free(1.45, 1.05)
 
 
@@ -152,8 +158,9 @@ def test_the_robot_leaves_a_nook_of_its_map_the_way_it_came() -> None:
     result, index = path_to_nearest(nav, path[-1], [(0.5, 0.5)], snap_m=0.5)
     assert index == 0 and result.found
     grid[25, 10] = OCCUPIED  # something put down in the slot since: the way back is closed
-    blocked = agent_nav_grid(OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25,
-                             stood_xy=path, retrace=True)
+    blocked = agent_nav_grid(
+        OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25, stood_xy=path, retrace=True
+    )
     assert path_to_nearest(blocked, path[-1], [(0.5, 0.5)], snap_m=0.5)[1] is None
 
 
@@ -178,3 +185,28 @@ def test_the_robot_can_drive_back_along_a_magic_actions_approach() -> None:
     nav = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=jump, retrace=True)
     path, index = path_to_nearest(nav, jump[-1], [jump[0]], snap_m=0.2)
     assert index == 0 and path.found and path.length_m == pytest.approx(4.4, abs=0.2)
+
+
+def test_a_region_is_typed_again_once_it_shows_twice_the_categories_it_was_typed_on() -> None:
+    """A garden first seen from its patio (a sofa, pillows) is typed a living room; the trees and bushes
+    seen later must reach the room classifier, else a car is never looked for there."""
+    _, body, _ = fresh()
+    asked: list[set[str]] = []
+
+    def label(graph: SceneGraph) -> dict[str, str]:
+        unlabelled = {rid for rid, r in graph.regions.items() if r.room_label is None}
+        asked.append(unlabelled)
+        return {rid: f"room{len(asked)}" for rid in unlabelled}
+
+    first = body.step_graph(label)
+    rid = first.robot.region_id
+    assert rid is not None and rid in asked[0] and first.regions[rid].room_label == "room1"
+    shows = len({o.category for o in first.objects_in(rid) if o.category != "door"})
+    assert shows >= 2
+    body.step_graph(label)
+    assert rid not in asked[1]  # nothing new seen: the label stays
+    body.typed_on[rid] = shows // 2  # as if typed when it showed half of what it shows now
+    again = body.step_graph(label)
+    assert rid in asked[2] and again.regions[rid].room_label == "room3"
+    assert body.step_graph(label).regions[rid].room_label == "room3"  # kept by the builder, not asked again
+    assert rid not in asked[3]

@@ -16,20 +16,21 @@ Every step (MPC style) it rebuilds the scene graph and:
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place (on a floor the description names only once
-   a region of that room type is known: until then it searches), put down what the hand holds but
+   a region of that room type is known, or the region where it found what the description says stays
+   on that floor: until then it searches), put down what the hand holds but
    does not need (on the floor, or on low furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore; none when
    only furniture is missing), explores the room most likely to hold the missing furniture
    (BEHAVIOR-1K room inventories), a room where the task's items were found (they are set out
-   together) before the others, a room whose explores still reveal new objects before the rest,
-   then the one explored least often, the nearest; each explore drives to the frontiers farthest
+   together) before the others, then the room whose frontiers show the most unseen floor, the
+   nearest; each explore drives to the frontiers farthest
    from the robot's path, of those to the ones with the most unseen floor in sensor range
    (information gain on the robot's own occupancy map). Before the search leaves the rooms where
    the task's items were found (or when their explores reveal nothing new) it drives to their
    tables, shelves and counters it has not been near, where small items show only from close by,
    and opens their closed containers (neither for missing furniture). A room whose last two
-   explores revealed nothing new yields to the other containers and closed doors; the planner
+   explores revealed nothing new (no object, under 10 m² of floor not mapped before) yields to the other containers and closed doors; the planner
    gives up with ``done`` when nothing is left to try.
 
 An action that fails twice the same way (its typed reason and the door in the way) is not repeated: its

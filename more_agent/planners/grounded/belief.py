@@ -62,8 +62,6 @@ class Belief:
     failures: Counter[FailureKey] = field(default_factory=Counter)
     opened_in_a_row: int = 0
     """Containers opened to look inside, one step after the other (``search.OPENS_BEFORE_EXPLORING``)."""
-    explored: Counter[str] = field(default_factory=Counter)
-    """Region id -> explore() calls so far."""
     fruitless: Counter[str] = field(default_factory=Counter)
     """Region id -> explore() calls in a row that revealed no new object (``search.FRUITLESS_EXPLORES``)."""
 
@@ -80,8 +78,12 @@ def learn_from_graph(belief: Belief, graph: SceneGraph) -> None:
             belief.looked_into.add(obj.label)
         if obj.held:
             belief.relation[obj.label] = None
-        elif obj.label in rel or not on_floor(belief.relation.get(obj.label)):
-            belief.relation[obj.label] = rel.get(obj.label) or on_ground(belief, obj)
+        elif obj.label in rel:
+            belief.relation[obj.label] = rel[obj.label]
+        elif not on_floor(belief.relation.get(obj.label)) or (obj.region_id is not None and on_ground(belief, obj)):
+            # a floor it was put on stays known unless the object shows on a floor of a region, whose room
+            # type is read again (the room may have been typed again: ``Embodiment.step_graph``)
+            belief.relation[obj.label] = on_ground(belief, obj)
 
 
 def bind(belief: Belief, goal: TaskGoal, scope: str, xy: XY) -> str | None:
@@ -120,6 +122,10 @@ def on_floor(rel: Relation | None) -> bool:
     return rel is not None and rel[1].startswith(f"{FLOOR} ")
 
 
+NEW_FLOOR_M2 = 10.0
+"""A step that maps this much floor not mapped before revealed something (``StepOutcome.news``)."""
+
+
 @dataclass(frozen=True)
 class StepOutcome:
     """What executing one step showed, beyond its result: read from the robot around the skill."""
@@ -130,7 +136,8 @@ class StepOutcome:
     region: str | None
     """The robot's region before the step."""
     news: bool
-    """Whether the step revealed an object not observed before."""
+    """Whether the step revealed an object not observed before, or ``NEW_FLOOR_M2`` of floor not mapped before
+    (a garden's explores show lawn and few objects: two without an object left its driveway unseen)."""
     path_length: int
     """Length of the robot's trajectory after the step."""
 
@@ -142,7 +149,6 @@ def learn_from_outcome(belief: Belief, goal: TaskGoal, action: Step, outcome: St
     if isinstance(target, Area):
         if action.name == "explore":
             assert target.region_id is not None
-            belief.explored[target.region_id] += 1
             belief.fruitless[target.region_id] = 0 if outcome.news else belief.fruitless[target.region_id] + 1
         elif result.ok and outcome.held is not None:  # put on a floor
             belief.relation[outcome.held] = on_floor_of(belief, target.region_id or outcome.region)

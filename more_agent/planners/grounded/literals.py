@@ -28,6 +28,9 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
     rel = belief.relation.get(a)
     if goal.is_floor(target):
         want = goal.floor_rooms.get(target)
+        if want is not None:  # the floor's room as the planner knows it (a garage typed otherwise, below)
+            region = floor_region(belief, sit, agenda, target)
+            want = want if region is None else belief.room_types.get(region, "")
         on = rel is not None and on_floor(rel) and (want is None or rel[1] == f"{FLOOR} {want}")
         return on != lit.negated
     b = bind(belief, goal, target, sit.xy)
@@ -37,12 +40,18 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
 
 
 def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> str | None:
-    """A reachable region whose room type is the floor's (the robot's when the description names none)."""
-    want = agenda.goal.floor_rooms.get(scope)
+    """A reachable region whose room type is the floor's (the robot's when the description names none); with
+    none of that type, the region where an object the description says stays on that floor was found
+    (``TaskGoal.stays``: Ihlen_0_int's garage holds a bookcase and a cabinet, no furniture of a garage)."""
+    goal = agenda.goal
+    want = goal.floor_rooms.get(scope)
     if want is None:
         return sit.here
     matches = sorted(rid for rid, kind in belief.room_types.items() if kind == want)
-    return matches[0] if matches else None
+    if matches:
+        return matches[0]
+    found = (belief.found_in.get(belief.bound.get(s, "")) for s, floor in sorted(goal.stays.items()) if floor == scope)
+    return next((rid for rid in found if rid is not None), None)
 
 
 def closes(lit: Literal) -> bool:

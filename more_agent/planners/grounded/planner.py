@@ -7,7 +7,7 @@ from collections.abc import Callable, Iterable
 
 from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace, needed
 from more_agent.planners.grounded.agenda import Agenda, agenda_of
-from more_agent.planners.grounded.belief import Belief, StepOutcome, learn_from_graph, learn_from_outcome
+from more_agent.planners.grounded.belief import NEW_FLOOR_M2, Belief, StepOutcome, learn_from_graph, learn_from_outcome
 from more_agent.planners.grounded.choose import choose
 from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.language import room_names
@@ -69,13 +69,13 @@ class GroundedPlanner:
         if action.name == DONE or action.target is None:
             return run_skill(body, graph, DONE, None)
         held = graph.held_object
-        known = len(body.observed)
+        known, mapped = len(body.observed), body.mapped_m2
         result = run_skill(body, graph, action.name, action.target)
         outcome = StepOutcome(
             result,
             held=held.label if held is not None else None,
             region=graph.robot.region_id,
-            news=len(body.observed) > known,
+            news=len(body.observed) > known or body.mapped_m2 - mapped >= NEW_FLOOR_M2,
             path_length=len(body.trajectory),
         )
         learn_from_outcome(self.belief, needed(self.agenda, "reset()").goal, action, outcome)

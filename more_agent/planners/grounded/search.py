@@ -14,7 +14,7 @@ from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief, bind
 from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
-from more_agent.planners.room_types import category_likelihood, is_furniture
+from more_agent.planners.room_types import is_furniture, listed_share
 from more_agent.planners.targets import Area
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
@@ -24,13 +24,18 @@ OPENS_BEFORE_EXPLORING = 3
 """Containers opened to look inside, one after the other, before the search explores again."""
 
 FRUITLESS_EXPLORES = 2
-"""A room whose last explores, this many in a row, revealed no new object yields to containers, doors, other rooms."""
+"""A room whose last explores, this many in a row, revealed no new object and little new floor
+(``belief.NEW_FLOOR_M2``) yields to containers, doors, other rooms."""
 
 FAR_FRONTIER_SHARE = 0.5
 """Explore goes to the frontiers at least this share as far from the robot's path as the farthest one."""
 
 INFORMATIVE_SHARE = 0.75
 """... and of those, to the ones showing at least this share of the most unknown floor in sensor range."""
+
+GAIN_STEP_M2 = 5.0
+"""Rooms whose frontiers show unseen floor within this many square metres of each other rank as equal
+(the nearer first)."""
 
 LOOK_AT_M = 2.0
 """Furniture of the task's rooms with a corner farther than this from everywhere the robot has been is
@@ -139,28 +144,43 @@ def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, hel
 
 def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: list[str], rooms: set[str]) -> str | None:
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
-    new last; then the room most likely to hold the missing furniture; then the rooms of the task's
-    items found so far (``rooms``, from :func:`task_rooms`); then a room whose explores still reveal new
-    objects before one not explored yet (a garden or a store is searched through, not left after a few
-    metres); then the least explored, the nearest."""
+    new last; then the room most likely to hold the missing furniture (by the share of the room type's
+    listed objects it makes up, :func:`~more_agent.planners.room_types.listed_share`); then the rooms of
+    the task's items found so far (``rooms``, from :func:`task_rooms`); then the room whose frontiers show
+    the most unseen floor in sensor range (``GAIN_STEP_M2`` steps: a garden or a store is searched through,
+    not left for a closet after a few metres, and a room nearly seen yields to one barely seen); then the
+    nearest."""
     cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
+    open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
+    gain = unseen_floor(sit, open_regions)
 
-    def score(rid: str) -> tuple[bool, float, bool, bool, int, float, str]:
+    def score(rid: str) -> tuple[bool, float, bool, int, float, str]:
         kind = belief.room_types.get(rid)
-        like = max((category_likelihood(c, kind) for c in cats), default=0.0) if kind else 0.0
-        productive = belief.explored[rid] > 0 and belief.fruitless[rid] == 0
+        like = max((listed_share(c, kind) for c in cats), default=0.0) if kind else 0.0
         return (
             stale(belief, rid),
             -like,
             rid not in rooms,
-            not productive,
-            belief.explored[rid],
+            -round(gain[rid] / GAIN_STEP_M2),
             math.dist(sit.graph.regions[rid].centroid, sit.xy),
             rid,
         )
 
-    open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     return min(open_regions, key=score) if open_regions else None
+
+
+def unseen_floor(sit: Situation, regions: Sequence[str]) -> dict[str, float]:
+    """Region id -> the most unseen floor (m^2) in sensor range of one of its frontiers (0 without a map)."""
+    occupancy = sit.graph.occupancy
+    frontiers = [(rid, f) for rid in regions for f in sit.graph.frontiers(rid)]
+    best = dict.fromkeys(regions, 0.0)
+    if occupancy is None or not frontiers:
+        return best
+    points = np.asarray([f for _, f in frontiers], dtype=float)
+    gain = visible_unknown_area(occupancy.grid, occupancy.frame, points, range_m=sit.sensor_range_m)
+    for (rid, _), g in zip(frontiers, gain):
+        best[rid] = max(best[rid], float(g))
+    return best
 
 
 def task_rooms(belief: Belief, agenda: Agenda) -> set[str]:

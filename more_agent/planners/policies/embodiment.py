@@ -29,6 +29,11 @@ PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
 
 
+RETYPE_GROWTH = 2
+"""A typed region is typed again once it shows this many times the object categories it was typed on: the
+first look into a garden may show only its patio's sofa and pillows (a living room), the rest of it trees and
+bushes. Doubling bounds the retyping (and a language model's room calls) to a logarithm of what a room holds."""
+
 LOOK_AROUND_TILT_DEG = 55.0
 """Head tilt of the downward looks in a full turn: with the Fetch's 63.3 deg view the image then spans 23 to
 87 deg below the horizon, the floor from right beside the base to 2.8 m out (``Embodiment.look_around``)."""
@@ -100,6 +105,8 @@ class Embodiment:
         self.observed: set[int] = set()
         """Instance ids seen so far, in view or in the hand (a planner tells from it whether a skill revealed anything)."""
         self.schedule = SensingSchedule(self.config.sensing)
+        self.typed_on: dict[str, int] = {}
+        """Region id -> how many object categories it showed when it was last typed (``RETYPE_GROWTH``)."""
 
     @property
     def xy(self) -> XY:
@@ -111,6 +118,12 @@ class Embodiment:
     def trajectory(self) -> Sequence[XY]:
         """Every base position since the episode began (the robot's odometry)."""
         return self.robot.trajectory
+
+    @property
+    def mapped_m2(self) -> float:
+        """Floor area the robot's map knows (free or occupied), square metres: how much an explore showed."""
+        cell = self.builder.config.resolution_m
+        return float(np.count_nonzero(self.builder.voxels.top_class >= 0)) * cell * cell
 
     @property
     def low_level_steps(self) -> int:
@@ -186,9 +199,20 @@ class Embodiment:
     def step_graph(self, label_rooms: Callable[[SceneGraph], dict[str, str]] | None = None) -> SceneGraph:
         """The scene graph a step plans on: :meth:`build` without the frontiers explored before (so the
         scene text and explore() agree), its unlabelled regions labelled by ``label_rooms`` (region id
-        -> room type; the builder keeps the labels for later steps)."""
+        -> room type; the builder keeps the labels for later steps), and so again each labelled region
+        that has come to show ``RETYPE_GROWTH`` times the object categories it was typed on (handed to
+        ``label_rooms`` without its label; it keeps its label when ``label_rooms`` gives none)."""
         graph = without_visited_frontiers(self.build(), self.visited_frontiers, self.config.visited_frontier_m)
-        labels = label_rooms(graph) if label_rooms is not None else {}
+        if label_rooms is None:
+            return graph
+        shown = {rid: len(_categories(graph, rid)) for rid in graph.regions}
+        grown = [
+            rid
+            for rid, region in graph.regions.items()
+            if region.room_label is not None and shown[rid] >= RETYPE_GROWTH * max(1, self.typed_on.get(rid, 0))
+        ]
+        labels = label_rooms(graph.without_room_labels(grown) if grown else graph)
+        self.typed_on.update({rid: shown[rid] for rid in labels})
         if labels:
             self.builder.set_room_labels(labels)
             graph = graph.with_room_labels(labels)
@@ -251,6 +275,11 @@ class Embodiment:
         if result.path:
             self.sense()
             self.sense(head=(0.0, math.radians(LOOK_AROUND_TILT_DEG)))
+
+
+def _categories(graph: SceneGraph, region_id: str) -> set[str]:
+    """The object categories a region shows, doors left out (every room has them)."""
+    return {o.category for o in graph.objects_in(region_id) if o.category != "door"}
 
 
 def without_visited_frontiers(graph: SceneGraph, visited: Sequence[XY], radius_m: float) -> SceneGraph:
