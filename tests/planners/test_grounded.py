@@ -480,7 +480,7 @@ def test_an_explore_that_maps_much_new_floor_is_not_fruitless(monkeypatch: pytes
         assert planner.body is not None and sit.here is not None and sit.graph.frontiers(sit.here)
         planner.body.observed.update(range(10_000))  # no object can be news: only the floor can
         before = planner.body.mapped_m2
-        planner.execute(HighLevelAction("explore", (sit.room(sit.here),), Area(sit.room(sit.here), sit.here)))
+        planner.execute(Step("explore", (sit.room(sit.here),), Area(sit.room(sit.here), sit.here)))
         return planner.body.mapped_m2 - before, belief.fruitless[sit.here]
 
     shown, fruitless = explore_here(NEW_FLOOR_M2)
