@@ -2,7 +2,13 @@
 
 ``GoalChecker`` compiles the goal once per task instance with ``bddl.activity.get_goal_conditions``
 and expands it into bddl's ground options (``get_ground_goal_state_options``: each option is a
-conjunction of ground literals that satisfies the goal; bddl keeps at most 20). ``check(world)``
+conjunction of ground literals that satisfies the goal; bddl keeps at most 20). bddl grounds a
+quantifier's variable to every object of its category, including the one a scope in its body names, so
+stacking_wood's ``(forall (?log.n.01 - log.n.01) (or (ontop ?log.n.01 ?table.n.02_1) (ontop ?log.n.01
+?log.n.01_1) ...))`` offers ``(ontop log.n.01_1 log.n.01_1)``, and all 20 options it kept held such a
+literal. :func:`ground_options` drops, at every node of the compiled goal, the options that relate an
+object to itself before bddl's limit counts them (11 of bddl's 1016 activities change, none of the others).
+``check(world)``
 reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
 option closest to being met, each conjunct's status: that option's satisfied share is the task
 progress (TP). The oracle reads the same option as structured ``Literal``s.
@@ -55,6 +61,26 @@ def literal_from_parsed(parsed: list[Any], scope: dict[str, ScopeObject]) -> Lit
     return Literal(predicate=atom[0], args=args, negated=negated)
 
 
+def ground_options(node: Any) -> None:
+    """Set the ground options of compiled goal ``node`` and of all below it, as bddl does (each node's own
+    ``get_ground_options``, children first), less the options that hold a positive literal relating an
+    object to itself (``ontop x x``: impossible by construction; bddl's ``forpairs`` already skips such
+    pairs), unless every option of the node does (an impossible branch stays as bddl offers it). Where
+    no literal relates an object to itself the options are bddl's, in bddl's order."""
+    for child in node.children:
+        for sub in child if isinstance(child, list) else [child]:  # forpairs children are rows of pairs
+            ground_options(sub)
+    node.get_ground_options()
+    possible = [option for option in node.flattened_condition_options if not any(map(_self_relation, option))]
+    if possible:
+        node.flattened_condition_options = possible
+
+
+def _self_relation(parsed: list[Any]) -> bool:
+    """Whether a ground literal (``['ontop', 'log.n.01_1', 'log.n.01_1']``) relates an object to itself."""
+    return parsed[0] != "not" and len(parsed) == 3 and parsed[1] == parsed[2]
+
+
 class GoalError(UserError):
     """A task whose goal cannot be evaluated condition by condition."""
 
@@ -70,10 +96,12 @@ class GoalChecker:
         if goal is not None:
             conds = copy.copy(conds)
             conds.parsed_goal_conditions = goal
-        goal = get_goal_conditions(conds, self.backend, dict(self.scope))
+        goal = get_goal_conditions(conds, self.backend, dict(self.scope), generate_ground_options=False)
         if not goal:
             raise ValueError(f"task {instance.task} has an empty goal")
         self._goal = goal
+        for head in goal:
+            ground_options(head)
         try:
             self._options = get_ground_goal_state_options(conds, self.backend, dict(self.scope), goal)
         except AssertionError:  # bddl asserts that it found at least one option
