@@ -6,8 +6,9 @@ conjunction of ground literals that satisfies the goal; bddl keeps at most 20). 
 quantifier's variable to every object of its category, including the one a scope in its body names, so
 stacking_wood's ``(forall (?log.n.01 - log.n.01) (or (ontop ?log.n.01 ?table.n.02_1) (ontop ?log.n.01
 ?log.n.01_1) ...))`` offers ``(ontop log.n.01_1 log.n.01_1)``, and all 20 options it kept held such a
-literal. :func:`ground_options` drops, at every node of the compiled goal, the options that relate an
-object to itself before bddl's limit counts them (11 of bddl's 1016 activities change, none of the others).
+literal; once those are dropped, the first left put log_1 on log_2 and log_2 on log_1. :func:`ground_options`
+drops, at every node of the compiled goal, the options that relate an object to itself, directly or
+through a cycle of placements, before bddl's limit counts them.
 ``check(world)``
 reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
 option closest to being met, each conjunct's status: that option's satisfied share is the task
@@ -20,6 +21,7 @@ import copy
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import networkx as nx
 from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_ground_goal_state_options
 from bddl.condition_evaluation import evaluate_state
 
@@ -63,22 +65,32 @@ def literal_from_parsed(parsed: list[Any], scope: dict[str, ScopeObject]) -> Lit
 
 def ground_options(node: Any) -> None:
     """Set the ground options of compiled goal ``node`` and of all below it, as bddl does (each node's own
-    ``get_ground_options``, children first), less the options that hold a positive literal relating an
-    object to itself (``ontop x x``: impossible by construction; bddl's ``forpairs`` already skips such
-    pairs), unless every option of the node does (an impossible branch stays as bddl offers it). Where
-    no literal relates an object to itself the options are bddl's, in bddl's order."""
+    ``get_ground_options``, children first), less the options no world can meet because they relate an
+    object to itself (:func:`relates_to_itself`; bddl's ``forpairs`` already skips such pairs), unless
+    every option of the node does (an impossible branch stays as bddl offers it). Where no option does,
+    the options are bddl's, in bddl's order."""
     for child in node.children:
         for sub in child if isinstance(child, list) else [child]:  # forpairs children are rows of pairs
             ground_options(sub)
     node.get_ground_options()
-    possible = [option for option in node.flattened_condition_options if not any(map(_self_relation, option))]
+    possible = [option for option in node.flattened_condition_options if not relates_to_itself(option)]
     if possible:
         node.flattened_condition_options = possible
 
 
-def _self_relation(parsed: list[Any]) -> bool:
-    """Whether a ground literal (``['ontop', 'log.n.01_1', 'log.n.01_1']``) relates an object to itself."""
-    return parsed[0] != "not" and len(parsed) == 3 and parsed[1] == parsed[2]
+def relates_to_itself(option: list[list[Any]]) -> bool:
+    """Whether a ground option's positive literals relate an object to itself: directly (``ontop x x``,
+    ``nextto x x``) or through a cycle of placements (``ontop a b`` with ``ontop b a``, or ``inside a b``
+    with ``ontop b a``), which no stack can hold. Negated literals never do."""
+    positive = [parsed for parsed in option if parsed[0] != "not" and len(parsed) == 3]
+    if any(parsed[1] == parsed[2] for parsed in positive):
+        return True
+    placements = nx.DiGraph([(parsed[1], parsed[2]) for parsed in positive if parsed[0] in _PLACEMENTS])
+    return not nx.is_directed_acyclic_graph(placements)
+
+
+_PLACEMENTS = ("ontop", "inside")
+"""Predicates that put their first object on or in the second: a chain of them cannot return to its start."""
 
 
 class GoalError(UserError):
