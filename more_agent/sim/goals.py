@@ -2,7 +2,14 @@
 
 ``GoalChecker`` compiles the goal once per task instance with ``bddl.activity.get_goal_conditions``
 and expands it into bddl's ground options (``get_ground_goal_state_options``: each option is a
-conjunction of ground literals that satisfies the goal; bddl keeps at most 20). ``check(world)``
+conjunction of ground literals that satisfies the goal; bddl keeps at most 20). bddl grounds a
+quantifier's variable to every object of its category, including the one a scope in its body names, so
+stacking_wood's ``(forall (?log.n.01 - log.n.01) (or (ontop ?log.n.01 ?table.n.02_1) (ontop ?log.n.01
+?log.n.01_1) ...))`` offers ``(ontop log.n.01_1 log.n.01_1)``, and all 20 options it kept held such a
+literal; once those are dropped, the first left put log_1 on log_2 and log_2 on log_1. :func:`ground_options`
+drops, at every node of the compiled goal, the options that relate an object to itself, directly or
+through a cycle of placements, before bddl's limit counts them.
+``check(world)``
 reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
 option closest to being met, each conjunct's status: that option's satisfied share is the task
 progress (TP). The oracle reads the same option as structured ``Literal``s.
@@ -14,6 +21,7 @@ import copy
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import networkx as nx
 from bddl.activity import evaluate_goal_conditions, get_goal_conditions, get_ground_goal_state_options
 from bddl.condition_evaluation import evaluate_state
 
@@ -55,6 +63,36 @@ def literal_from_parsed(parsed: list[Any], scope: dict[str, ScopeObject]) -> Lit
     return Literal(predicate=atom[0], args=args, negated=negated)
 
 
+def ground_options(node: Any) -> None:
+    """Set the ground options of compiled goal ``node`` and of all below it, as bddl does (each node's own
+    ``get_ground_options``, children first), less the options no world can meet because they relate an
+    object to itself (:func:`relates_to_itself`; bddl's ``forpairs`` already skips such pairs), unless
+    every option of the node does (an impossible branch stays as bddl offers it). Where no option does,
+    the options are bddl's, in bddl's order."""
+    for child in node.children:
+        for sub in child if isinstance(child, list) else [child]:  # forpairs children are rows of pairs
+            ground_options(sub)
+    node.get_ground_options()
+    possible = [option for option in node.flattened_condition_options if not relates_to_itself(option)]
+    if possible:
+        node.flattened_condition_options = possible
+
+
+def relates_to_itself(option: list[list[Any]]) -> bool:
+    """Whether a ground option's positive literals relate an object to itself: directly (``ontop x x``,
+    ``nextto x x``) or through a cycle of placements (``ontop a b`` with ``ontop b a``, or ``inside a b``
+    with ``ontop b a``), which no stack can hold. Negated literals never do."""
+    positive = [parsed for parsed in option if parsed[0] != "not" and len(parsed) == 3]
+    if any(parsed[1] == parsed[2] for parsed in positive):
+        return True
+    placements = nx.DiGraph([(parsed[1], parsed[2]) for parsed in positive if parsed[0] in _PLACEMENTS])
+    return not nx.is_directed_acyclic_graph(placements)
+
+
+_PLACEMENTS = ("ontop", "inside")
+"""Predicates that put their first object on or in the second: a chain of them cannot return to its start."""
+
+
 class GoalError(UserError):
     """A task whose goal cannot be evaluated condition by condition."""
 
@@ -70,10 +108,12 @@ class GoalChecker:
         if goal is not None:
             conds = copy.copy(conds)
             conds.parsed_goal_conditions = goal
-        goal = get_goal_conditions(conds, self.backend, dict(self.scope))
+        goal = get_goal_conditions(conds, self.backend, dict(self.scope), generate_ground_options=False)
         if not goal:
             raise ValueError(f"task {instance.task} has an empty goal")
         self._goal = goal
+        for head in goal:
+            ground_options(head)
         try:
             self._options = get_ground_goal_state_options(conds, self.backend, dict(self.scope), goal)
         except AssertionError:  # bddl asserts that it found at least one option

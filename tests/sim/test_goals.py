@@ -110,3 +110,32 @@ def test_check_another_world() -> None:
     other.world.place("canned_food_1", other.scope["cabinet.n.01_1"], "inside")
     assert checker.check(other.world).progress == pytest.approx(0.2)
     assert checker.check(inst.world).progress == 0.0
+
+
+def test_options_never_relate_an_object_to_itself() -> None:
+    """stacking_wood's forall over logs offers ``ontop`` each log: bddl's 20 options all held ``(ontop log_1 log_1)``,
+    and the first without it put log_1 on log_2 and log_2 on log_1."""
+    from more_agent.sim.instantiate import instantiate
+
+    checker = GoalChecker(instantiate("stacking_wood"))
+    assert checker.n_options == 20
+    options = [checker.ground_literals(i) for i in range(checker.n_options)]
+    assert all(lit.negated or len(set(lit.args)) == len(lit.args) for option in options for lit in option)
+    placed = [{lit.args for lit in option if lit.predicate == "ontop" and not lit.negated} for option in options]
+    assert not any((b, a) in pairs for pairs in placed for a, b in pairs)  # nor log_1 on log_2 on log_1
+    assert all(any(lit.args[1].startswith("log_") for lit in option) for option in options)  # logs on logs kept
+
+
+@pytest.mark.parametrize("task", ["putting_shopping_away", "putting_dishes_away_after_cleaning"])
+def test_options_are_bddls_where_none_relates_an_object_to_itself(task: str) -> None:
+    from bddl.activity import get_goal_conditions, get_ground_goal_state_options
+
+    from more_agent.sim.goals import literal_from_parsed
+
+    inst = _inst(task)
+    checker = GoalChecker(inst)
+    conds, scope = inst.definition.conditions, inst.scope_objects()
+    goal = get_goal_conditions(conds, checker.backend, dict(scope))
+    bddl_options = get_ground_goal_state_options(conds, checker.backend, dict(scope), goal)
+    ours = [checker.ground_literals(i) for i in range(checker.n_options)]
+    assert ours == [[literal_from_parsed(head.body, scope) for head in option] for option in bddl_options]
