@@ -13,6 +13,7 @@ random generator is seeded by (episode seed, task), so an episode replays the sa
 
 from __future__ import annotations
 
+import re
 import zlib
 from collections.abc import Iterable, Mapping
 from dataclasses import replace
@@ -155,6 +156,16 @@ class NoisyPerception:
         """The real object's label behind a label this perception made up; any other label as it is."""
         name = self.aliases.get(label.strip())
         return label if name is None else self.labels.reserve(self.world.objects[name])
+
+    def perceived_text(self, text: str, acted_on: Mapping[str, str]) -> str:
+        """``text`` (an action's feedback) naming objects as this perception does: each real label of
+        ``acted_on`` as the label the robot acted on, every other confused instance under its fresh label
+        (the item held when placing, a support), so no message shows a planner a name it never saw."""
+        names = {**self._seen_as, **acted_on}
+        if not names:
+            return text
+        pattern = re.compile("|".join(rf"\b{re.escape(k)}\b" for k in sorted(names, key=len, reverse=True)))
+        return pattern.sub(lambda m: names[m.group(0)], text)
 
     def room_input(self, objects: Iterable[tuple[str, str]]) -> list[str]:
         """The categories the room classifier reads for (label, category) pairs: each object's, or, for the

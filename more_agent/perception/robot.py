@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from dataclasses import replace
 
 from more_agent.perception.model import NoisyPerception
 from more_agent.robot import XY, ActionResult, Observation, Robot
@@ -71,16 +72,8 @@ class NoisyRobot:
         """The world action on the real object behind ``target``; its feedback names it as perceived."""
         real = self.noise.real_label(target)
         result = self.inner.act(action, real)
-        if real == target or not real:
-            return result
-        return ActionResult(
-            ok=result.ok,
-            reason=result.reason,
-            feedback=result.feedback.replace(real, target),
-            low_level_steps=result.low_level_steps,
-            path=result.path,
-            blocking=result.blocking,
-        )
+        feedback = self.noise.perceived_text(result.feedback, {real: target} if real and real != target else {})
+        return result if feedback == result.feedback else replace(result, feedback=feedback)
 
     def reach_distance(self, target: str) -> float | None:
         return self.inner.reach_distance(self.noise.real_label(target))

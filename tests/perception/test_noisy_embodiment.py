@@ -72,3 +72,15 @@ def test_missed_objects_leave_the_graph_and_the_observed_set() -> None:
     _, _, graph, noise = looked_around("noisy:miss=1,confusion=0,fragment=0,merge=0,depth=0,drift=0,room=0")
     assert noise is not None and len(graph.objects) < len(gt_graph.objects)
     assert set(graph.objects) < set(gt_graph.objects)  # nothing made up: the rest are named as themselves
+
+
+def test_feedback_names_every_confused_object_as_perceived() -> None:
+    """A message about an action (the held item when placing, a support) never shows the real label of an
+    object perception names otherwise: the planner would learn what it never saw."""
+    inst, _, _, noise = looked_around("noisy:confusion=1,miss=0,fragment=0,merge=0,depth=0,drift=0,room=0")
+    assert noise is not None and len(noise.aliases) >= 2
+    (fresh, name), (other_fresh, other) = list(noise.aliases.items())[:2]
+    real, other_real = inst.labels.label(name), inst.labels.label(other)
+    text = f"cannot place {real} on {other_real}; {real}B stays"  # a longer label is not touched
+    assert noise.perceived_text(text, {}) == f"cannot place {fresh} on {other_fresh}; {real}B stays"
+    assert noise.perceived_text(text, {real: "bowl Z"}).startswith("cannot place bowl Z on ")  # the target's label
