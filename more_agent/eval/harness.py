@@ -31,8 +31,10 @@ from more_agent.eval.store import (
     RunConfig,
     check_run_dir,
     episode_dir,
+    index_records,
     pending,
     prepare_run_dir,
+    recorded,
     retire_retryable,
     with_past_failures,
 )
@@ -298,10 +300,10 @@ def redraw_missing_maps(config: RunConfig, run_dir: Path, records: list[EpisodeR
 
     if not pictures_enabled():
         return 0
-    by_key = {(r.task, r.seed, r.trial, r.planner, r.llm, r.start): r for r in records}
+    index = index_records(records)
     redrawn = 0
     for spec in config_specs(config):
-        record = by_key.get((spec.task, spec.seed, spec.trial, spec.planner, spec.llm, spec.start))
+        record = recorded(spec, index)
         out_dir = episode_dir(run_dir, spec)
         if record is None or not record.trajectory or not out_dir.is_dir() or map_is_complete(out_dir / MAP_FILE):
             continue

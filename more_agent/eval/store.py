@@ -13,6 +13,7 @@ import hashlib
 import json
 import os
 import re
+from collections.abc import Iterable
 from pathlib import Path
 from types import TracebackType
 
@@ -256,12 +257,27 @@ def retire_retryable(run_dir: Path, records: list[EpisodeRecord]) -> list[Episod
     return kept
 
 
+RecordIndex = dict[tuple[object, ...], list[EpisodeRecord]]
+"""Records grouped by what they share with their spec (:func:`index_records`, :func:`recorded`)."""
+
+
+def index_records(records: Iterable[EpisodeRecord]) -> RecordIndex:
+    """``records`` grouped for :func:`recorded`, so matching specs to records is not quadratic."""
+    index: RecordIndex = {}
+    for r in records:
+        index.setdefault(_match_key(r), []).append(r)
+    return index
+
+
+def recorded(spec: EpisodeSpec, index: RecordIndex) -> EpisodeRecord | None:
+    """The record of ``spec`` in ``index`` (the first that is :func:`of_spec`), or None."""
+    return next((r for r in index.get(_match_key(spec), []) if of_spec(r, spec)), None)
+
+
 def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[EpisodeSpec]:
     """The specs with no record yet, in order (a record counts for a spec when it is :func:`of_spec`)."""
-    done: dict[tuple[object, ...], list[EpisodeRecord]] = {}
-    for r in records:
-        done.setdefault(_match_key(r), []).append(r)
-    return [s for s in specs if not any(of_spec(r, s) for r in done.get(_match_key(s), []))]
+    index = index_records(records)
+    return [s for s in specs if recorded(s, index) is None]
 
 
 def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> bool:

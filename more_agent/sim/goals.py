@@ -8,9 +8,7 @@ stacking_wood's ``(forall (?log.n.01 - log.n.01) (or (ontop ?log.n.01 ?table.n.0
 ?log.n.01_1) ...))`` offers ``(ontop log.n.01_1 log.n.01_1)``, and all 20 options it kept held such a
 literal; once those are dropped, the first left put log_1 on log_2 and log_2 on log_1. :func:`ground_options`
 drops, at every node of the compiled goal, the options that relate an object to itself, directly or
-through a cycle of placements, before bddl's limit counts them.
-``check(world)``
-reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
+through a cycle of placements, before bddl's limit counts them. ``check(world)`` reports whether the whole goal holds (bddl's own evaluation, quantifiers included) and, for the
 option closest to being met, each conjunct's status: that option's satisfied share is the task
 progress (TP). The oracle reads the same option as structured ``Literal``s.
 """
