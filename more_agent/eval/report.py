@@ -36,6 +36,8 @@ SUMMARY_CSV = "summary.csv"
 REPORT_HTML = "report.html"
 ALL_TASKS = "ALL"
 """Task column value of the overall rows in summary.csv."""
+ALL_TRIALS = "ALL"
+"""Trial column value of the summary.csv rows over every trial."""
 
 
 class SourcedRecord(NamedTuple):
@@ -208,8 +210,9 @@ def _csv_cells(e: Estimate | None) -> list[str]:
 
 
 def summary_csv(records: Sequence[EpisodeRecord]) -> str:
-    """summary.csv: one row per system overall (task = 'ALL') and per (system, task); ``n_rTP``: the
-    episodes that have an rTP (empty rTP cells when none has)."""
+    """summary.csv: one row per system overall (task = 'ALL') and per (system, task), both over every
+    trial (``trial`` = 'ALL'); with ``eval --trials``, also one overall row per (system, trial) after the
+    system's overall row. ``n_rTP``: the episodes that have an rTP (empty rTP cells when none has)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(
@@ -221,10 +224,17 @@ def summary_csv(records: Sequence[EpisodeRecord]) -> str:
             "n_errors",
             *(f"{m}{s}" for m in METRIC_NAMES for s in ("", "_low", "_high")),
             "n_rTP",
+            "trial",
         ]
     )
-    rows = [((k, ALL_TASKS), s) for k, s in by_system(records).items()] + list(by_task(records).items())
-    for (system, task), s in rows:
+    rows: list[tuple[str, str, str, MetricSummary]] = []
+    for system, group in group_by(records, system_label).items():
+        rows.append((system, ALL_TASKS, ALL_TRIALS, summarize(group)))
+        if has_trials(records):
+            per_trial = group_by(group, lambda r: f"{r.trial:06d}")
+            rows += [(system, ALL_TASKS, str(int(t)), summarize(v)) for t, v in sorted(per_trial.items())]
+    rows += [(system, task, ALL_TRIALS, s) for (system, task), s in by_task(records).items()]
+    for system, task, trial, s in rows:
         cells = [c for m in METRIC_NAMES for c in _csv_cells(getattr(s, m))]
-        w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *cells, s.rTP.n if s.rTP is not None else 0])
+        w.writerow([system, task, s.n, s.n_tasks, s.n_errors, *cells, s.rTP.n if s.rTP is not None else 0, trial])
     return buf.getvalue()

@@ -64,6 +64,20 @@ def test_markdown_and_csv_have_a_row_per_system_and_task() -> None:
     assert "flat-shaded boxes" in caveats and "ground-truth" in caveats and "magic actions" in caveats
 
 
+def test_csv_has_an_overall_row_per_trial_when_a_run_has_trials() -> None:
+    records = [rec("t1", trial=0), rec("t1", trial=1, success=True), rec("t2", trial=1, success=True)]
+    rows = [(r["task"], r["trial"], r["n"], r["SR"]) for r in csv.DictReader(io.StringIO(summary_csv(records)))]
+    assert rows == [
+        ("ALL", "ALL", "3", "0.666667"),
+        ("ALL", "0", "1", "0.000000"),
+        ("ALL", "1", "2", "1.000000"),
+        ("t1", "ALL", "2", "0.500000"),
+        ("t2", "ALL", "1", "1.000000"),
+    ]
+    single = list(csv.DictReader(io.StringIO(summary_csv([rec("t1")]))))
+    assert [r["trial"] for r in single] == ["ALL", "ALL"]
+
+
 def test_rtp_cells_say_n_when_episodes_have_none(tmp_path: Path) -> None:
     blind = rec("t2").model_copy(update={"observed_objects": []})  # saw no task object: no rTP
     records = [rec("t1"), blind]
