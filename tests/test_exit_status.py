@@ -17,6 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 from more_agent.cli import app
+from more_agent.eval.pictures import ENV_PICTURES
 from more_agent.eval.runlock import locked_run_dir
 from more_agent.eval.store import read_records
 from tests.fakes.openai_server import FakeOpenAIServer, Status
@@ -149,7 +150,7 @@ def test_run_refuses_a_folder_of_another_episode_and_cleans_its_own(tmp_path: Pa
     assert code == 0 and not (ep / "steps.jsonl").exists(), text
 
 
-def test_no_file_is_written_through_a_symlink(tmp_path: Path, pictures_on: None) -> None:
+def test_no_file_is_written_through_a_symlink(tmp_path: Path, pictures_on: None, monkeypatch: pytest.MonkeyPatch) -> None:
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")
     ep = tmp_path / "ep"
@@ -162,6 +163,7 @@ def test_no_file_is_written_through_a_symlink(tmp_path: Path, pictures_on: None)
     (ep / ".lock").symlink_to(victim)
     code, text = _invoke([*ORACLE, "--out", str(ep)])
     assert code == 2 and "symlink" in text and victim.read_text() == "precious", text
+    monkeypatch.setenv(ENV_PICTURES, "0")  # map.png above needed the pictures; summary.md below does not
     run = tmp_path / "run"
     assert _invoke(_eval(run))[0] == 0
     (run / "summary.md").unlink()
