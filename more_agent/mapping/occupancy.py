@@ -68,7 +68,8 @@ def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -
 @numba.njit(cache=True)
 def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lut):
     """Clear the non-free-space voxels that rays pass through (sampled every ``res``) before
-    their hit (or max range)."""
+    their hit (or max range). Each voxel index is monotone along a ray, so a ray that has left the
+    grid never comes back: its march stops there."""
     h, w = depth.shape
     nx, ny, nz = cls.shape
     for v in range(stride // 2, h, stride):
@@ -81,14 +82,17 @@ def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lu
             dx = (rot[0, 0] * a + rot[0, 1] * b + rot[0, 2]) / norm
             dy = (rot[1, 0] * a + rot[1, 1] * b + rot[1, 2]) / norm
             dz = (rot[2, 0] * a + rot[2, 1] * b + rot[2, 2]) / norm
-            t = 0.0
+            t, inside = 0.0, False
             while t < length - res:
                 ix = int(np.floor((trans[0] + t * dx - origin[0]) / res))
                 iy = int(np.floor((trans[1] + t * dy - origin[1]) / res))
                 iz = int(np.floor((trans[2] + t * dz - origin[2]) / res))
                 t += res
                 if not (0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz):
+                    if inside:
+                        break
                     continue
+                inside = True
                 c = cls[ix, iy, iz]
                 if c != 0 and not free_lut[c - 1]:
                     cls[ix, iy, iz] = 0
@@ -117,6 +121,24 @@ def _insert(depth, semantic, instance, use, intr, rot, trans, cls, inst, origin,
             if 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
                 cls[ix, iy, iz] = semantic[v, u] + 1
                 inst[ix, iy, iz] = instance[v, u]
+
+
+@numba.njit(cache=True)
+def _instance_cells(cls, inst):
+    """Flat indices (ascending) and ids of the occupied voxels with an instance id > 0: one pass over
+    the grid instead of numpy's three full-size temporaries (the grid is tens of millions of voxels)."""
+    n = 0
+    for k in range(inst.size):
+        if inst[k] > 0 and cls[k] > 0:
+            n += 1
+    flat = np.empty(n, dtype=np.int64)
+    ids = np.empty(n, dtype=inst.dtype)
+    n = 0
+    for k in range(inst.size):
+        if inst[k] > 0 and cls[k] > 0:
+            flat[n], ids[n] = k, inst[k]
+            n += 1
+    return flat, ids
 
 
 @numba.njit(cache=True)
@@ -247,10 +269,9 @@ class VoxelMap:
 
     def instance_voxels(self) -> dict[int, np.ndarray]:
         """World coordinates (k, 3) of the occupied voxel centres of every instance id > 0."""
-        flat = np.flatnonzero((self.inst > 0) & (self.cls > 0))
+        flat, ids = _instance_cells(self.cls.reshape(-1), self.inst.reshape(-1))
         if flat.size == 0:
             return {}
-        ids = self.inst.ravel()[flat]
         order = np.argsort(ids, kind="stable")
         flat, ids = flat[order], ids[order]
         pts = self._centres(*np.unravel_index(flat, self.inst.shape))

@@ -97,3 +97,16 @@ def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
     cell = tuple(vmap.grid.cell_of((2.07, 0.0)))
     assert vmap.occupancy()[cell] == FREE
     assert 3 in vmap.instance_voxels()
+
+
+def test_instance_voxels_groups_every_instance_voxel_in_grid_order() -> None:
+    """The compiled pass of instance_voxels keeps numpy's selection: voxels with an instance id and a
+    class, in flat grid order per instance."""
+    from more_agent.mapping.occupancy import _instance_cells
+
+    rng = np.random.default_rng(1)
+    cls = rng.integers(0, 3, (9, 7, 5)).astype(np.uint16)
+    inst = rng.integers(-1, 4, (9, 7, 5)).astype(np.int32)
+    flat, ids = _instance_cells(cls.reshape(-1), inst.reshape(-1))
+    expected = np.flatnonzero((inst > 0) & (cls > 0))
+    assert np.array_equal(flat, expected) and np.array_equal(ids, inst.ravel()[expected])
