@@ -217,10 +217,10 @@ class VoxelMap:
         pad_hi = np.where(high > size, high - size + margin, 0)
         start, stop = self._view_start - pad_lo, self._view_start + size + pad_hi
         if (start < 0).any() or (stop > self._top_buf.shape).any():
-            start = np.where(pad_lo > 0, size, 0)  # room for as much again on each growing side: few copies
+            start = size.copy()  # room for as much again on every side: few copies
             stop = start + pad_lo + size + pad_hi
             old = self.cls, self.inst, self.top_class
-            self._allocate(tuple(stop + np.where(pad_hi > 0, size, 0)))
+            self._allocate(tuple(stop + size))
             kept = (slice(start[0] + pad_lo[0], stop[0] - pad_hi[0]), slice(start[1] + pad_lo[1], stop[1] - pad_hi[1]))
             self._cls_buf[kept], self._inst_buf[kept], self._top_buf[kept] = old
         self._view(start, stop)
