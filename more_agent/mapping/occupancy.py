@@ -68,7 +68,8 @@ def depth_to_points(depth: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray) -
 @numba.njit(cache=True)
 def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lut):
     """Clear the non-free-space voxels that rays pass through (sampled every ``res``) before
-    their hit (or max range)."""
+    their hit (or max range). Each voxel index is monotone along a ray, so a ray that has left the
+    grid never comes back: its march stops there."""
     h, w = depth.shape
     nx, ny, nz = cls.shape
     for v in range(stride // 2, h, stride):
@@ -81,14 +82,17 @@ def _carve(depth, intr, rot, trans, cls, origin, res, max_range, stride, free_lu
             dx = (rot[0, 0] * a + rot[0, 1] * b + rot[0, 2]) / norm
             dy = (rot[1, 0] * a + rot[1, 1] * b + rot[1, 2]) / norm
             dz = (rot[2, 0] * a + rot[2, 1] * b + rot[2, 2]) / norm
-            t = 0.0
+            t, inside = 0.0, False
             while t < length - res:
                 ix = int(np.floor((trans[0] + t * dx - origin[0]) / res))
                 iy = int(np.floor((trans[1] + t * dy - origin[1]) / res))
                 iz = int(np.floor((trans[2] + t * dz - origin[2]) / res))
                 t += res
                 if not (0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz):
+                    if inside:
+                        break
                     continue
+                inside = True
                 c = cls[ix, iy, iz]
                 if c != 0 and not free_lut[c - 1]:
                     cls[ix, iy, iz] = 0
@@ -117,6 +121,30 @@ def _insert(depth, semantic, instance, use, intr, rot, trans, cls, inst, origin,
             if 0 <= ix < nx and 0 <= iy < ny and 0 <= iz < nz:
                 cls[ix, iy, iz] = semantic[v, u] + 1
                 inst[ix, iy, iz] = instance[v, u]
+
+
+@numba.njit(cache=True)
+def _instance_cells(cls, inst):
+    """Flat indices (ascending, C order of the grid's shape) and ids of the occupied voxels with an
+    instance id > 0: one pass over the grid instead of numpy's three full-size temporaries (the grid
+    is tens of millions of voxels, and a view into a larger buffer, see ``VoxelMap._ensure_covers``)."""
+    nx, ny, nz = inst.shape
+    n = 0
+    for ix in range(nx):
+        for iy in range(ny):
+            for iz in range(nz):
+                if inst[ix, iy, iz] > 0 and cls[ix, iy, iz] > 0:
+                    n += 1
+    flat = np.empty(n, dtype=np.int64)
+    ids = np.empty(n, dtype=inst.dtype)
+    n = 0
+    for ix in range(nx):
+        for iy in range(ny):
+            for iz in range(nz):
+                if inst[ix, iy, iz] > 0 and cls[ix, iy, iz] > 0:
+                    flat[n], ids[n] = (ix * ny + iy) * nz + iz, inst[ix, iy, iz]
+                    n += 1
+    return flat, ids
 
 
 @numba.njit(cache=True)
@@ -167,16 +195,18 @@ class VoxelMap:
         return self.top_class.shape
 
     def _ensure_covers(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        """Grow the grid (whole cells, existing content kept) so that [lo, hi] in xy lies inside."""
+        """Grow the grid (whole cells, existing content kept) so that [lo, hi] in xy lies inside: by the
+        cells missing plus half the initial extent on each side that lacks them. The arrays are views into
+        buffers with room to spare, so most growths only widen the view (a copy of a house's grid is
+        tens of megabytes)."""
         res = self.grid.resolution_m
         if self.cls.shape[0] == 0:
             half = max(self.initial_extent_m / 2, float(np.max(hi - lo)) / 2 + res)
             centre = (lo + hi) / 2
             self._move_corner(np.round((centre - half) / res) * res)
             n = int(np.ceil(2 * half / res))
-            self.cls = np.zeros((n, n, self._nz), dtype=np.uint16)
-            self.inst = np.zeros((n, n, self._nz), dtype=np.int32)
-            self.top_class = np.full((n, n), -1, dtype=np.int32)
+            self._allocate((n, n))
+            self._view(np.zeros(2, dtype=int), np.array([n, n]))
             return
         size = np.array(self.shape)
         low, high = self.grid.cell_range(lo, hi)
@@ -185,11 +215,29 @@ class VoxelMap:
         margin = int(np.ceil(self.initial_extent_m / 2 / res))
         pad_lo = np.where(low < 0, -low + margin, 0)
         pad_hi = np.where(high > size, high - size + margin, 0)
-        pads = ((pad_lo[0], pad_hi[0]), (pad_lo[1], pad_hi[1]))
-        self.cls = np.pad(self.cls, (*pads, (0, 0)))
-        self.inst = np.pad(self.inst, (*pads, (0, 0)))
-        self.top_class = np.pad(self.top_class, pads, constant_values=-1)
+        start, stop = self._view_start - pad_lo, self._view_start + size + pad_hi
+        if (start < 0).any() or (stop > self._top_buf.shape).any():
+            start = size.copy()  # room for as much again on every side: few copies
+            stop = start + pad_lo + size + pad_hi
+            old = self.cls, self.inst, self.top_class
+            self._allocate(tuple(stop + size))
+            kept = (slice(start[0] + pad_lo[0], stop[0] - pad_hi[0]), slice(start[1] + pad_lo[1], stop[1] - pad_hi[1]))
+            self._cls_buf[kept], self._inst_buf[kept], self._top_buf[kept] = old
+        self._view(start, stop)
         self._move_corner(np.asarray(self.grid.origin_xy) - pad_lo * res)
+
+    def _allocate(self, shape: tuple[int, ...]) -> None:
+        """Fresh empty buffers of ``shape`` columns. What lies outside the view is never written, so it is
+        still empty when a growth brings it in; untouched, it takes no memory (zeroed pages come on use)."""
+        self._cls_buf = np.zeros((*shape, self._nz), dtype=np.uint16)
+        self._inst_buf = np.zeros((*shape, self._nz), dtype=np.int32)
+        self._top_buf = np.full(shape, -1, dtype=np.int32)
+
+    def _view(self, start: np.ndarray, stop: np.ndarray) -> None:
+        """Point ``cls``, ``inst`` and ``top_class`` at the buffers' columns [start, stop)."""
+        window = (slice(int(start[0]), int(stop[0])), slice(int(start[1]), int(stop[1])))
+        self._view_start = np.asarray(start)
+        self.cls, self.inst, self.top_class = self._cls_buf[window], self._inst_buf[window], self._top_buf[window]
 
     def _move_corner(self, origin_xy: np.ndarray) -> None:
         self.grid = Grid(origin_xy=(float(origin_xy[0]), float(origin_xy[1])), resolution_m=self.grid.resolution_m)
@@ -247,10 +295,9 @@ class VoxelMap:
 
     def instance_voxels(self) -> dict[int, np.ndarray]:
         """World coordinates (k, 3) of the occupied voxel centres of every instance id > 0."""
-        flat = np.flatnonzero((self.inst > 0) & (self.cls > 0))
+        flat, ids = _instance_cells(self.cls, self.inst)
         if flat.size == 0:
             return {}
-        ids = self.inst.ravel()[flat]
         order = np.argsort(ids, kind="stable")
         flat, ids = flat[order], ids[order]
         pts = self._centres(*np.unravel_index(flat, self.inst.shape))

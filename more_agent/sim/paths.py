@@ -57,14 +57,17 @@ class NavGrid(Grid):
     @cached_property
     def _nearest_free(self) -> tuple[np.ndarray, np.ndarray]:
         # y-major, see the module docstring
-        _, (iys, ixs) = ndimage.distance_transform_edt(~self.free.T, return_indices=True)
+        iys, ixs = ndimage.distance_transform_edt(~self.free.T, return_distances=False, return_indices=True)
         return ixs.T, iys.T
 
     def snap(self, x: float, y: float) -> tuple[int, int] | None:
-        """The free cell nearest to (x, y), or None when the grid has no free cell."""
+        """The free cell nearest to (x, y), or None when the grid has no free cell. A free cell is its own
+        nearest (what the distance transform would say too), so only off-free points pay for the transform."""
+        cell = self.cell_at(x, y)
+        if self.free[cell]:
+            return cell
         if not self.free.any():
             return None
-        cell = self.cell_at(x, y)
         ixs, iys = self._nearest_free
         return int(ixs[cell]), int(iys[cell])
 

@@ -85,6 +85,25 @@ def test_grid_grows_and_keeps_content_and_ignored_instances_are_not_mapped() -> 
     assert 9 not in vmap.instance_voxels()
 
 
+def test_growth_in_every_direction_keeps_the_map_and_brings_in_only_unknown_cells() -> None:
+    """Growths that widen the view into spare buffer room and growths that copy into a new buffer both
+    keep what was mapped where it was and add unknown columns only: the sky-pointed camera sees nothing."""
+    K = intrinsics(32)
+    floor = Box((-1, -1, -0.05), (1, 1, 0.0), "floor")
+    crate = Box((0.3, -0.3, 0.0), (0.8, 0.3, 0.6), "cabinet", 9)
+    vmap = _vmap()
+    T = camera_pose(0, 0, 0.0)
+    vmap.integrate(*render([floor, crate], K, T, 32), K, T)
+    crate_voxels, seen, filled = vmap.instance_voxels()[9], int((vmap.top_class >= 0).sum()), int((vmap.cls > 0).sum())
+    for x, y in [(20, 0), (-20, 0), (0, 25), (0, -25), (45, 0), (0, 60)]:
+        shape = vmap.shape
+        T2 = camera_pose(x, y, 0.0)
+        vmap.integrate(np.full((32, 32), np.nan), np.zeros((32, 32), int), np.zeros((32, 32), int), K, T2)
+        assert vmap.shape != shape
+        assert np.allclose(vmap.instance_voxels()[9], crate_voxels, rtol=0, atol=1e-9)
+        assert int((vmap.top_class >= 0).sum()) == seen and int((vmap.cls > 0).sum()) == filled
+
+
 def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
     K = intrinsics(96)
     floor = Box((-10, -10, -0.05), (10, 10, 0.0), "floor")
@@ -97,3 +116,20 @@ def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
     cell = tuple(vmap.grid.cell_of((2.07, 0.0)))
     assert vmap.occupancy()[cell] == FREE
     assert 3 in vmap.instance_voxels()
+
+
+def test_instance_voxels_groups_every_instance_voxel_in_grid_order() -> None:
+    """The compiled pass of instance_voxels keeps numpy's selection: voxels with an instance id and a
+    class, in flat grid order; on a view into a larger buffer too (how the voxel map holds its grid)."""
+    from more_agent.mapping.occupancy import _instance_cells
+
+    rng = np.random.default_rng(1)
+    cls = rng.integers(0, 3, (9, 7, 5)).astype(np.uint16)
+    inst = rng.integers(-1, 4, (9, 7, 5)).astype(np.int32)
+    flat, ids = _instance_cells(cls, inst)
+    expected = np.flatnonzero((inst > 0) & (cls > 0))
+    assert np.array_equal(flat, expected) and np.array_equal(ids, inst.ravel()[expected])
+    flat, ids = _instance_cells(
+        np.pad(cls, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3], np.pad(inst, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3]
+    )
+    assert np.array_equal(flat, expected) and np.array_equal(ids, inst.ravel()[expected])

@@ -210,3 +210,21 @@ def test_a_region_is_typed_again_once_it_shows_twice_the_categories_it_was_typed
     assert rid in asked[2] and again.regions[rid].room_label == "room3"
     assert body.step_graph(label).regions[rid].room_label == "room3"  # kept by the builder, not asked again
     assert rid not in asked[3]
+
+
+def test_within_answers_like_the_whole_grids_distance_transform() -> None:
+    """The cropped distance test behind agent_nav_grid's inflation and blind radius gives the whole
+    grid's transform's answer on every cell that asks (random grids, radii, a map with unknown rim)."""
+    from scipy import ndimage
+
+    from more_agent.planners.policies.navigation import _within
+
+    rng = np.random.default_rng(0)
+    for trial in range(200):
+        grid = rng.choice([0, FREE, OCCUPIED], size=tuple(rng.integers(5, 60, 2)), p=[0.5, 0.4, 0.1])
+        grid[: grid.shape[0] // 3] = 0  # an unknown rim, as a growing map has
+        radius = float(rng.uniform(0.05, 0.6))
+        known, occupied = grid == FREE, grid == OCCUPIED
+        whole = ndimage.distance_transform_edt(~occupied) * 0.075 > radius
+        cropped = ~_within(occupied, radius, 0.075, around=known if occupied.any() else None)
+        assert np.array_equal(known & whole, known & cropped), trial

@@ -44,15 +44,17 @@ def agent_nav_grid(
     grid = np.array(occupancy.grid)
     bumps = _cells(occupancy, bumped_xy)
     grid[bumps[:, 0], bumps[:, 1]] = OCCUPIED
-    clearance = ndimage.distance_transform_edt(grid != OCCUPIED) * occupancy.resolution_m
+    res = occupancy.resolution_m
     known_free = grid == FREE
     path = _path_cells(occupancy, stood_xy)
     if len(path) and blind_radius_m > 0:
-        seeds = np.ones(grid.shape, dtype=bool)
-        seeds[path[:, 0], path[:, 1]] = False
-        near = ndimage.distance_transform_edt(seeds) * occupancy.resolution_m <= blind_radius_m
+        seeds = np.zeros(grid.shape, dtype=bool)
+        seeds[path[:, 0], path[:, 1]] = True
+        near = _within(seeds, blind_radius_m, res, around=seeds)
         known_free |= near & (grid != OCCUPIED)
-    free = known_free & (clearance > inflation_m)
+    occupied = grid == OCCUPIED
+    # with no obstacle at all, scipy's transform measures to the grid's rim: keep that on the whole grid
+    free = known_free & ~_within(occupied, inflation_m, res, around=known_free if occupied.any() else None)
     if retrace:
         free[path[:, 0], path[:, 1]] |= grid[path[:, 0], path[:, 1]] != OCCUPIED
     return NavGrid(
@@ -61,6 +63,32 @@ def agent_nav_grid(
         free=free,
         closed_doors=frozenset(),
         door_cells={},
+    )
+
+
+def _within(targets: np.ndarray, radius_m: float, res: float, *, around: np.ndarray | None) -> np.ndarray:
+    """Whether each cell lies within ``radius_m`` of a ``targets`` cell (the Euclidean distance transform's
+    test, to the bit), evaluated only in the box of the ``around`` cells grown by the radius (False outside;
+    the whole grid when None). A target within the radius of a cell in the box lies in the grown box, so
+    the box's transform answers like the whole grid's: most of a growing map is unknown rim, never asked."""
+    out = np.zeros(targets.shape, dtype=bool)
+    box = _grown_box(around, math.ceil(radius_m / res) + 1) if around is not None else (slice(None), slice(None))
+    if box is None:
+        return out
+    crop = targets[box]
+    if around is None or crop.any():
+        out[box] = ndimage.distance_transform_edt(~crop) * res <= radius_m
+    return out
+
+
+def _grown_box(mask: np.ndarray, margin: int) -> tuple[slice, slice] | None:
+    """The bounding box of the True cells of ``mask`` grown by ``margin`` cells (clipped), None when none."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if rows.size == 0:
+        return None
+    return (
+        slice(max(rows[0] - margin, 0), rows[-1] + margin + 1),
+        slice(max(cols[0] - margin, 0), cols[-1] + margin + 1),
     )
 
 
