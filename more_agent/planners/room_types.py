@@ -36,6 +36,13 @@ def is_furniture(category: str) -> bool:
     return any(category in counts for counts in room_type_counts().values())
 
 
+def is_standing_furniture(category: str) -> bool:
+    """Whether a category is furniture that stands on its own (big enough for a scene to place it as
+    furniture: ``catalog.furniture_role``), not a loose item such as a pillow or a beach toy: what rests
+    on a loose item lying on a floor rests on that floor too (docs/tasks.md, predicate semantics)."""
+    return catalog.furniture_role(category) != "skip"
+
+
 def category_likelihood(category: str, room_type: str) -> float:
     """Smoothed share of ``room_type``'s furniture that is ``category`` (0 for unknown room types)."""
     counts = room_type_counts().get(room_type)

@@ -17,6 +17,7 @@ from more_agent.planners.grounded.belief import (
     Belief,
     StepOutcome,
     bind,
+    floor_beneath,
     learn_from_graph,
     learn_from_outcome,
     on_floor,
@@ -36,8 +37,14 @@ from more_agent.planners.grounded.search import (
     unseen_floor,
 )
 from more_agent.planners.grounded.situation import Situation
-from more_agent.planners.grounded.steps import put_down
-from more_agent.planners.room_types import category_likelihood, is_furniture, likely_room_type, listed_share
+from more_agent.planners.grounded.steps import put_down, support_for
+from more_agent.planners.room_types import (
+    category_likelihood,
+    is_furniture,
+    is_standing_furniture,
+    likely_room_type,
+    listed_share,
+)
 from more_agent.planners.targets import Area
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
@@ -285,6 +292,33 @@ def test_an_object_resting_on_no_furniture_is_on_the_floor() -> None:
     belief.bound["yogurt"] = "cup_of_yogurt A"
     assert holds(belief, sit, agenda, Literal("ontop", ("bag", floor))) is True
     assert holds(belief, sit, agenda, Literal("ontop", ("yogurt", floor))) is False
+
+
+def test_what_rests_on_a_loose_item_lying_on_a_floor_is_on_that_floor() -> None:
+    """ontop a floor follows a stack of ontop links over loose items, not through standing furniture nor an
+    'inside' link (remove_sod: sods put on a beach toy or a pillow on the lawn were believed off it)."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    floor = next(iter(agenda.goal.floor_rooms))
+    belief.bound["yogurt"] = "cup_of_yogurt A"
+    on_lawn = Literal("ontop", ("yogurt", floor))
+    for support, on in (("paper_bag A", True), ("countertop A", False), ("box_of_cereal A", False)):
+        belief.relation["cup_of_yogurt A"] = ("ontop", support)  # the box of cereal is inside the bag
+        assert holds(belief, sit, agenda, on_lawn) is on, support
+        assert (floor_beneath(belief, "cup_of_yogurt A") is not None) is on
+
+
+def test_an_item_that_must_leave_the_floor_is_not_put_on_a_loose_item_lying_there() -> None:
+    """The nearest low support is skipped when it is a loose item on the floor (a box the room lists)."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    box = belief.seen["box_of_cereal A"]
+    belief.seen["box_of_cereal A"] = box.model_copy(update={"position": (sit.xy[0], sit.xy[1], 0.1)})
+    belief.relation["box_of_cereal A"] = ("ontop", f"{FLOOR} private_office")
+    assert is_furniture(box.category) and not is_standing_furniture(box.category)
+    support = support_for(belief, sit, "cup_of_yogurt A")
+    assert support is not None and support != "box_of_cereal A"
+    assert is_standing_furniture(belief.seen[support].category)
+    belief.relation["box_of_cereal A"] = ("ontop", "countertop A")  # on standing furniture: a fine support
+    assert support_for(belief, sit, "cup_of_yogurt A") == "box_of_cereal A"
 
 
 def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> None:

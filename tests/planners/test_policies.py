@@ -18,7 +18,8 @@ from more_agent.planners.policies import (
     path_to_nearest,
     pick_target,
 )
-from more_agent.planners.policies.skills import place_on_floor
+from more_agent.planners.policies.embodiment import PolicyConfig
+from more_agent.planners.policies.skills import BACK_OUT_M, back_out, place_on_floor
 from more_agent.records import FailureReason
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim.env import SimRobot
@@ -162,6 +163,44 @@ def test_the_robot_leaves_a_nook_of_its_map_the_way_it_came() -> None:
         OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1), inflation_m=0.25, stood_xy=path, retrace=True
     )
     assert path_to_nearest(blocked, path[-1], [(0.5, 0.5)], snap_m=0.5)[1] is None
+
+
+class DrivenBody:
+    """What ``back_out`` reads of an Embodiment, and the ways it is told to drive."""
+
+    def __init__(self, trajectory: list[tuple[float, float]]) -> None:
+        self.config = PolicyConfig(plan_inflation_m=0.25, blind_radius_m=0.0)
+        self.trajectory, self.bumps = trajectory, []
+        self.driven: list[list[tuple[float, float]]] = []
+
+    @property
+    def xy(self) -> tuple[float, float]:
+        return self.trajectory[-1]
+
+    def follow(self, waypoints: list[tuple[float, float]]) -> bool:
+        self.driven.append(waypoints)
+        return True
+
+
+def test_a_robot_blocked_in_a_slot_backs_out_through_the_exact_positions_it_came_by() -> None:
+    """A final approach left the base in a slot narrower than the map's clearance (Beechwood's car
+    beside the fence): it drives back through the positions it held, not cell centres, to the first
+    with full clearance; standing with full clearance, or with none near, it does not."""
+    grid = np.full((60, 20), FREE)  # [ix, iy], 0.1 m cells; open floor at x < 2 m
+    grid[20:, :] = OCCUPIED
+    grid[20:, 9:13] = FREE  # a slot 0.4 m wide: all of it within the 0.25 m inflation
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    way_in = [(1.0 + 0.07 * k, 1.03 + 0.001 * k) for k in range(30)]
+    body = DrivenBody(list(way_in))
+    assert back_out(body, occupancy)  # type: ignore[arg-type]
+    (driven,) = body.driven
+    free = agent_nav_grid(occupancy, inflation_m=0.25)
+    assert driven == [way_in[-1], *way_in[::-1][1 : len(driven)]]  # exactly the positions held, backwards
+    assert free.is_free(*driven[-1]) and not any(free.is_free(*xy) for xy in driven[:-1])
+    outside = DrivenBody(way_in[:3])
+    assert not back_out(outside, occupancy) and not outside.driven  # type: ignore[arg-type]
+    deep = [(2.1 + 0.07 * k, 1.03) for k in range(int(BACK_OUT_M / 0.07) + 5)]
+    assert not back_out(DrivenBody(deep), occupancy)  # type: ignore[arg-type]
 
 
 def test_the_graph_shows_the_hand_empty_right_after_a_floor_placement() -> None:

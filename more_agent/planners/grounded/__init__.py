@@ -12,13 +12,14 @@ Every step (MPC style) it rebuilds the scene graph and:
    nearest unbound instance of a category that counts as the scope's synset; bindings stay;
 2. evaluates every literal of the goal option on what it believes (observed open state and spatial
    relations, its own placements on floors, objects whose box reaches the ground on their room's
-   floor) and calls ``done`` when all hold;
+   floor, and what rests on a loose item lying on a floor: ``belief.floor_beneath``) and calls ``done``
+   when all hold;
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place (on a floor the description names only once
    a region of that room type is known, or the region where it found what the description says stays
    on that floor: until then it searches), put down what the hand holds but
-   does not need (on the floor, or on low furniture when the goal wants it off that floor);
+   does not need (on the floor, or on low standing furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore; none when
    only furniture is missing), explores the room most likely to hold the missing furniture

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from more_agent.goal import TaskGoal
 from more_agent.planners.base import Step
+from more_agent.planners.room_types import is_standing_furniture
 from more_agent.planners.targets import Area
 from more_agent.records import FailureReason
 from more_agent.robot import XY, ActionResult
@@ -115,6 +116,20 @@ def on_ground(belief: Belief, obj: ObjectNode) -> Relation | None:
 def on_floor_of(belief: Belief, region: str | None) -> Relation:
     """The relation of an object resting on the floor of ``region``, named by its room type."""
     return ("ontop", f"{FLOOR} {belief.room_types.get(region or '', '')}")
+
+
+def floor_beneath(belief: Belief, label: str) -> Relation | None:
+    """The floor ``label`` rests on, directly or through a stack of 'ontop' links over loose items: a sod
+    on a pillow lying on the lawn is on the lawn (docs/tasks.md, predicate semantics). None when it rests
+    on standing furniture (which has no floor beneath it in that sense), inside something, or is held."""
+    rel, visited = belief.relation.get(label), {label}
+    while rel is not None and not on_floor(rel):
+        support = belief.seen.get(rel[1])
+        if rel[0] != "ontop" or support is None or rel[1] in visited or is_standing_furniture(support.category):
+            return None
+        visited.add(rel[1])
+        rel = belief.relation.get(rel[1])
+    return rel
 
 
 def on_floor(rel: Relation | None) -> bool:

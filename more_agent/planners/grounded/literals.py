@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from more_agent.goal import Literal
 from more_agent.planners.grounded.agenda import Agenda
-from more_agent.planners.grounded.belief import Belief, bind, on_floor
+from more_agent.planners.grounded.belief import Belief, bind, floor_beneath
 from more_agent.planners.grounded.situation import Situation
 from more_agent.vocabulary import FLOOR
 
@@ -25,18 +25,18 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
     a = bind(belief, goal, subject, sit.xy)
     if a is None:
         return None
-    rel = belief.relation.get(a)
     if goal.is_floor(target):
         want = goal.floor_rooms.get(target)
         if want is not None:  # the floor's room as the planner knows it (a garage typed otherwise, below)
             region = floor_region(belief, sit, agenda, target)
             want = want if region is None else belief.room_types.get(region, "")
-        on = rel is not None and on_floor(rel) and (want is None or rel[1] == f"{FLOOR} {want}")
+        floor = floor_beneath(belief, a)
+        on = floor is not None and (want is None or floor[1] == f"{FLOOR} {want}")
         return on != lit.negated
     b = bind(belief, goal, target, sit.xy)
     if b is None:
         return None
-    return (rel == (lit.predicate, b)) != lit.negated
+    return (belief.relation.get(a) == (lit.predicate, b)) != lit.negated
 
 
 def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> str | None:

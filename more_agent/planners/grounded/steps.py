@@ -8,9 +8,9 @@ from dataclasses import dataclass
 from more_agent.planners.base import Step
 from more_agent.planners.goal_order import PUT_DOWN_MAX_TOP_M
 from more_agent.planners.grounded.agenda import Agenda
-from more_agent.planners.grounded.belief import Belief
+from more_agent.planners.grounded.belief import Belief, floor_beneath
 from more_agent.planners.grounded.situation import Situation
-from more_agent.planners.room_types import is_furniture
+from more_agent.planners.room_types import is_furniture, is_standing_furniture
 from more_agent.planners.targets import Area
 from more_agent.vocabulary import FLOOR
 
@@ -70,7 +70,8 @@ def off_floor(belief: Belief, agenda: Agenda, held: str, region: str | None) -> 
 
 def support_for(belief: Belief, sit: Situation, held: str) -> str | None:
     """The nearest reachable observed furniture to put ``held`` on top of: low enough to reach
-    (``PUT_DOWN_MAX_TOP_M``), not closed, not given up on; in the robot's room first."""
+    (``PUT_DOWN_MAX_TOP_M``), not closed, not given up on, not a loose item lying on a floor (what is put
+    on it rests on that floor: :func:`~.belief.floor_beneath`); in the robot's room first."""
     spots = [
         o
         for label in reachable(belief, sit)
@@ -80,6 +81,7 @@ def support_for(belief: Belief, sit: Situation, held: str) -> str | None:
         and o.category != "door"
         and o.bbox.max[2] <= PUT_DOWN_MAX_TOP_M
         and o.open is not False
+        and (is_standing_furniture(o.category) or floor_beneath(belief, label) is None)
     ]
     if not spots:
         return None

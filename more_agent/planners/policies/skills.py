@@ -50,7 +50,42 @@ def _drive(
         if body.follow(path.waypoints):
             return True, index, ""
         occupancy = body.build().occupancy
+        if occupancy is not None and back_out(body, occupancy):
+            occupancy = body.build().occupancy
     return False, None, "the way is blocked"
+
+
+BACK_OUT_M = 4.0
+"""How far back along its own way the robot retraces, at most, to a place with full clearance."""
+
+
+def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
+    """After a blocked move, drive back along the robot's own way in, through the exact positions it
+    held (each segment was driven before), to the last one with the full clearance of the agent's map:
+    a final approach can leave the base in a slot narrower than that clearance (between a car and a
+    fence), where paths through grid-cell centres graze what the exact way in missed, every move
+    blocked. False when the robot stands with full clearance, none lies within ``BACK_OUT_M``, or the
+    way back is blocked too."""
+    cfg = body.config
+    grid = agent_nav_grid(
+        occupancy,
+        inflation_m=cfg.plan_inflation_m,
+        stood_xy=body.trajectory,
+        blind_radius_m=cfg.blind_radius_m,
+        bumped_xy=body.bumps,
+    )
+    if grid.is_free(*body.xy):
+        return False
+    way, length = [body.xy], 0.0
+    for xy in reversed(body.trajectory):
+        length += math.dist(xy, way[-1])
+        if length > BACK_OUT_M:
+            return False
+        if math.dist(xy, way[-1]) > 1e-6:
+            way.append(xy)
+        if grid.is_free(*xy):
+            return body.follow(way)
+    return False
 
 
 def _plan(
