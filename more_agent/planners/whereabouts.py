@@ -31,6 +31,9 @@ MAX_LEVELS = 1
 """How many generations up the taxonomy a synset may borrow evidence from: a drill's siblings are hand
 tools; two generations up, every tool, a kitchen's ladles among them."""
 
+NEVER_INSIDE_ACTIVITIES = 3
+"""Activities placing an item, none of them inside anything, that make it one never kept in a container."""
+
 PLACEMENTS = ("ontop", "inside", "under", "nextto")
 """Init predicates that place an item relative to another object."""
 
@@ -113,14 +116,19 @@ def room_prior(synset: str, leave_out: str = "") -> dict[str, float]:
     return {kind: n / total for kind, n in counts.items()}
 
 
-def container_prior(synset: str, leave_out: str = "") -> dict[str, float] | None:
-    """Container synset -> share of the item's evidence placing it inside one; None without evidence
-    (nothing known: any container may hold it), {} when the evidence never puts it inside anything."""
+def container_prior(synset: str, leave_out: str = "") -> dict[str, float]:
+    """Container synset -> share of the item's evidence placing it inside one ({} without such evidence)."""
     evs = evidence(synset, leave_out)
-    if not evs:
-        return None
     counts = Counter(e.support for e in evs if e.inside)
     return {support: n / len(evs) for support, n in counts.items()}
+
+
+def never_inside(synset: str, leave_out: str = "") -> bool:
+    """Whether at least ``NEVER_INSIDE_ACTIVITIES`` activities place the item and none inside anything: a
+    car, a bow, a branch is kept in no container. Thinner evidence says nothing (containers in the corpus
+    are named finely: a grocery store's fridge is no kitchen's)."""
+    evs = evidence(synset, leave_out)
+    return len({e.activity for e in evs}) >= NEVER_INSIDE_ACTIVITIES and not any(e.inside for e in evs)
 
 
 def container_share(category: str, prior: dict[str, float]) -> float:

@@ -17,7 +17,7 @@ from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import is_furniture, listed_share
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import container_prior, container_share, room_prior
+from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
 from more_agent.sim.catalog import can_hold_things, category_size, is_surface, sized_categories
@@ -44,7 +44,7 @@ LIKELY_ROOM_SHARE = 0.1
 """A room type holding this share of the missing items' evidence is searched before rooms of unknown type."""
 
 UNKNOWN_CONTAINER_SHARE = 0.05
-"""How likely a container that fits holds an item the activity corpus never places."""
+"""How likely a container that fits holds an item the corpus never places in one of its kind."""
 
 LOOK_AT_M = 2.0
 """Furniture of the task's rooms with a corner farther than this from everywhere the robot has been is
@@ -53,7 +53,8 @@ driven to when an item is missing."""
 
 def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: str | None) -> Choice:
     """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
-    containers, closed doors; give up when none is left."""
+    containers, closed doors (before a room of a type unlikely to hold the missing items: a car is outside),
+    containers that cannot hold them (:func:`closed_containers`); give up when none is left."""
     goal = agenda.goal
     missing = [
         s for s in lit.args if s != goal.robot and not goal.is_floor(s) and bind(belief, goal, s, sit.xy) is None
@@ -80,9 +81,9 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
             return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
     doors = closed_doors(belief, sit)
     unlikely = region is not None and room_tier(belief, region, kept) == UNLIKELY
-    if region is not None and not stale(belief, region) and not (unlikely and (closed or doors)):
+    if region is not None and not stale(belief, region) and not (unlikely and doors):
         return explore_step(sit, region, note)
-    for pool in (closed, doors):
+    for pool in (doors, closed) if unlikely else (closed, doors):  # a car is outside: open the way out first
         if pool:
             return open_to_look(belief, sit, agenda, pool[0].label, held, note)
     if region is not None:
@@ -120,18 +121,22 @@ def closed_containers(
 
 
 def container_likelihood(agenda: Agenda, container: str, items: Sequence[str]) -> float:
-    """How likely a closed ``container`` category holds one of the missing ``items`` (scopes): the largest
-    share of an item's evidence inside such containers (:func:`~more_agent.planners.whereabouts.container_prior`),
-    ``UNKNOWN_CONTAINER_SHARE`` for an item without evidence, 0 for an item too large for it (catalog sizes:
-    a suitcase is in no microwave). With no item named (looking for a room), every container may."""
+    """How likely a closed ``container`` category holds one of the missing ``items`` (scopes), for the
+    order containers are opened in: for an item that fits in it (catalog sizes: a suitcase is in no
+    microwave) and that the corpus does not show as never kept inside anything
+    (:func:`~more_agent.planners.whereabouts.never_inside`), ``UNKNOWN_CONTAINER_SHARE`` plus the share of
+    its evidence inside such containers (:func:`~more_agent.planners.whereabouts.container_prior`); the
+    largest over the items, 0 when none may be inside. With no item named (looking for a room), any may."""
     if not items:
         return UNKNOWN_CONTAINER_SHARE
     best = 0.0
+    activity = agenda.goal.activity
     for scope in items:
-        if not fits(agenda.goal.categories.get(scope, frozenset()), container):
+        synset = scope_synset(scope)
+        if not fits(agenda.goal.categories.get(scope, frozenset()), container) or never_inside(synset, activity):
             continue
-        prior = container_prior(scope_synset(scope), agenda.goal.activity)
-        best = max(best, UNKNOWN_CONTAINER_SHARE if prior is None else container_share(container, prior))
+        share = container_share(container, container_prior(synset, activity))
+        best = max(best, UNKNOWN_CONTAINER_SHARE + share)
     return best
 
 
