@@ -26,6 +26,7 @@ from more_agent.planners.grounded.choose import act_for, choose
 from more_agent.planners.grounded.literals import floor_region, holds
 from more_agent.planners.grounded.search import (
     FRUITLESS_EXPLORES,
+    LIKELY,
     OPENS_BEFORE_EXPLORING,
     UNLIKELY,
     closed_containers,
@@ -507,6 +508,7 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     sack = "sack.n.01_1"
     kept = item_rooms(agenda.goal, [sack])
     assert kept["kitchen"] > kept["garden"] > 0  # sacks are kept in kitchens, sometimes on a lawn
+    assert room_tier(belief, here, kept) == LIKELY and room_tier(belief, far, kept) == UNLIKELY  # under half as often
     assert unseen_floor(sit, [here, far])[far] > unseen_floor(sit, [here, far])[here] + 5.0
     assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # the likelier room, nearer and smaller
     assert room_to_explore(belief, sit, agenda, [], set()) == far  # nothing missing: the most unseen floor

@@ -41,7 +41,10 @@ GAIN_STEP_M2 = 5.0
 (the nearer first)."""
 
 LIKELY_ROOM_SHARE = 0.1
-"""A room type holding this share of the missing items' evidence is searched before rooms of unknown type."""
+"""A room type holding this share of the missing items' evidence is searched before rooms of unknown type ..."""
+
+LIKELY_OF_TOP = 0.5
+"""... when it also holds this share of what the likeliest room type holds."""
 
 UNKNOWN_CONTAINER_SHARE = 0.05
 """How likely a container that fits holds an item the corpus never places in one of its kind."""
@@ -235,13 +238,15 @@ LIKELY, UNTYPED, UNLIKELY = 0, 1, 2
 
 
 def room_tier(belief: Belief, region: str, kept: dict[str, float]) -> int:
-    """``LIKELY`` when the region's room type holds a ``LIKELY_ROOM_SHARE`` of the missing items' evidence,
-    ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its type is unknown or the items have
-    no evidence (``kept`` empty: every room as likely)."""
+    """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing items'
+    evidence and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the lawn that holds a
+    fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its type is unknown
+    or the items have no evidence (``kept`` empty: every room as likely)."""
     kind = belief.room_types.get(region)
     if not kept or kind is None:
         return UNTYPED
-    return LIKELY if kept.get(kind, 0.0) >= LIKELY_ROOM_SHARE else UNLIKELY
+    share = kept.get(kind, 0.0)
+    return LIKELY if share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * max(kept.values()) else UNLIKELY
 
 
 def item_rooms(goal: TaskGoal, items: Sequence[str]) -> dict[str, float]:
