@@ -20,9 +20,10 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
+from typing import Any
 
 from more_agent.sim import catalog
-from more_agent.sim.tasks import load_task, scope_synset, task_names
 
 MIN_EVIDENCE = 1
 """Items placed in other activities below which a synset borrows its parents' evidence (its siblings')."""
@@ -50,19 +51,30 @@ class Evidence:
     inside: bool
 
 
+def scope_synset(scope: str) -> str:
+    """'apple.n.01_1' -> 'apple.n.01'."""
+    return scope.lstrip("?").rsplit("_", 1)[0]
+
+
 @cache
 def corpus() -> dict[str, tuple[Evidence, ...]]:
-    """Item synset -> its evidence over every bddl activity."""
+    """Item synset -> its evidence over every bddl activity (read with bddl's own parser: static knowledge
+    of the library, not the episode's task, which planners may not import)."""
+    from bddl.config import ACTIVITY_CONFIGS_PATH
+    from bddl.parsing import parse_domain, parse_problem
+
+    domain, *_ = parse_domain("omnigibson")
     found: dict[str, list[Evidence]] = {}
-    for name in task_names():
-        for synset, ev in _activity_evidence(name):
+    for name in sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir()):
+        init = parse_problem(name, 0, domain)[2]
+        for synset, ev in _activity_evidence(name, init):
             found.setdefault(synset, []).append(ev)
     return {s: tuple(evs) for s, evs in found.items()}
 
 
-def _activity_evidence(name: str) -> list[tuple[str, Evidence]]:
-    """(item synset, evidence) for each item the activity's initial state places on or in something."""
-    init = [lit for lit in load_task(name).init if lit and isinstance(lit[0], str)]
+def _activity_evidence(name: str, parsed: list[Any]) -> list[tuple[str, Evidence]]:
+    """(item synset, evidence) for each item the activity's initial state (``parsed``) places on or in something."""
+    init = [lit for lit in parsed if lit and isinstance(lit[0], str)]
     room = {lit[1]: lit[2] for lit in init if lit[0] == "inroom" and len(lit) == 3}
     rests = {lit[1]: (lit[0], lit[2]) for lit in init if lit[0] in PLACEMENTS and len(lit) == 3}
     out = []
