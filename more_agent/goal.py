@@ -58,6 +58,9 @@ class TaskGoal:
     """Scope -> the floor scope the description says it stays on ("every carton stays on the garage floor",
     "leave toolbox A on the garage floor"): a goal literal ``ontop`` a floor whose room the description
     names that holds from the start. Where the robot finds the object is that room, whatever its furniture."""
+    activity: str = ""
+    """The bddl activity the goal is of: the commonsense priors read from the activity corpus leave it out
+    (:mod:`more_agent.planners.whereabouts`)."""
 
     def is_floor(self, scope: str) -> bool:
         return scope in self.floor_rooms

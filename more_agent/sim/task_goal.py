@@ -83,6 +83,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         robot=robot,
         moved=frozenset(moved),
         stays=staying(options, floors, instance.definition.init),
+        activity=instance.definition.name,
     )
 
 

@@ -27,10 +27,17 @@ from more_agent.planners.grounded.choose import act_for, choose
 from more_agent.planners.grounded.literals import floor_region, holds
 from more_agent.planners.grounded.search import (
     FRUITLESS_EXPLORES,
+    LIKELY,
     OPENS_BEFORE_EXPLORING,
+    UNLIKELY,
+    closed_containers,
+    container_likelihood,
     far_frontiers,
+    fits,
     informative,
     is_furniture_scope,
+    item_rooms,
+    room_tier,
     room_to_explore,
     search,
     task_rooms,
@@ -520,3 +527,45 @@ def test_an_explore_that_maps_much_new_floor_is_not_fruitless(monkeypatch: pytes
     shown, fruitless = explore_here(NEW_FLOOR_M2)
     assert 0 < shown < NEW_FLOOR_M2 and fruitless == 1  # the small kitchen's last corner: nothing new
     assert explore_here(shown / 2) == (shown, 0)  # the same floor, were it much: news
+
+
+def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_lawn() -> None:
+    """Where an item is kept outranks how much floor a room still hides: a kitchen half seen before a
+    lawn whose frontiers show a whole disc of unseen floor, when a sack is missing (outfit_a_basic_toolbox
+    seed 0 spent 35 of 50 steps on a 65 m lawn while the tools lay in the utility room). A room whose type
+    is not known yet comes before a known unlikely one; with no item missing, the unseen floor decides."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    here = sit.here
+    assert here is not None
+    belief.room_types = {here: "kitchen", far: "garden"}
+    sack = "sack.n.01_1"
+    kept = item_rooms(agenda.goal, [sack])
+    assert kept["kitchen"] > kept["garden"] > 0  # sacks are kept in kitchens, sometimes on a lawn
+    assert room_tier(belief, here, kept) == LIKELY and room_tier(belief, far, kept) == UNLIKELY  # under half as often
+    assert unseen_floor(sit, [here, far])[far] > unseen_floor(sit, [here, far])[here] + 5.0
+    assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # the likelier room, nearer and smaller
+    assert room_to_explore(belief, sit, agenda, [], set()) == far  # nothing missing: the most unseen floor
+    belief.room_types[far] = "bathroom"
+    assert room_tier(belief, far, kept) == UNLIKELY
+    del belief.room_types[here]
+    assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # untyped before unlikely
+    belief.room_types[far] = "kitchen"
+    assert room_to_explore(belief, sit, agenda, [sack], set()) == far  # a likely type before an untyped room
+
+
+def test_containers_too_small_or_never_holding_the_missing_item_are_opened_last() -> None:
+    """Plates are looked for in cabinets before fridges; a suitcase fits in no microwave and is not looked
+    for there while rooms and doors are left (packing_car_for_trip opened 25 cabinets for suitcases)."""
+    assert not fits(frozenset({"suitcase"}), "microwave") and fits(frozenset({"apple"}), "microwave")
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    scope = "plate.n.04_1"
+    plates = with_goal(agenda, categories={**agenda.goal.categories, scope: frozenset({"plate"})})
+    assert container_likelihood(plates, "bottom_cabinet", [scope]) > container_likelihood(plates, "car", [scope]) > 0
+    closed, _ = closed_containers(belief, sit, plates, [scope])
+    assert [o.category for o in closed][:2] == ["bottom_cabinet"] * 2  # likeliest first, the fridge after
+    suitcase = "suitcase.n.01_1"
+    bags = with_goal(agenda, categories={**agenda.goal.categories, suitcase: frozenset({"suitcase"})})
+    closed, others = closed_containers(belief, sit, bags, [suitcase])  # no evidence: any container it fits
+    assert all(fits(frozenset({"suitcase"}), o.category) for o in closed)
+    assert all(not fits(frozenset({"suitcase"}), o.category) for o in others)

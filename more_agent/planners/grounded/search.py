@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from functools import cache
 
 import numpy as np
 
-from more_agent.goal import Literal
+from more_agent.goal import Literal, TaskGoal
 from more_agent.mapping import visible_unknown_area
 from more_agent.planners.base import DONE, Step
 from more_agent.planners.grounded.agenda import Agenda
@@ -16,9 +17,10 @@ from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import is_furniture, listed_share
 from more_agent.planners.targets import Area
+from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior, scope_synset
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
-from more_agent.sim.catalog import can_hold_things, is_surface
+from more_agent.sim.catalog import can_hold_things, category_size, is_surface, sized_categories
 
 OPENS_BEFORE_EXPLORING = 3
 """Containers opened to look inside, one after the other, before the search explores again."""
@@ -37,6 +39,15 @@ GAIN_STEP_M2 = 5.0
 """Rooms whose frontiers show unseen floor within this many square metres of each other rank as equal
 (the nearer first)."""
 
+LIKELY_ROOM_SHARE = 0.1
+"""A room type holding this share of the missing items' evidence is searched before rooms of unknown type ..."""
+
+LIKELY_OF_TOP = 0.5
+"""... when it also holds this share of what the likeliest room type holds."""
+
+UNKNOWN_CONTAINER_SHARE = 0.05
+"""How likely a container that fits holds an item the corpus never places in one of its kind."""
+
 LOOK_AT_M = 2.0
 """Furniture of the task's rooms with a corner farther than this from everywhere the robot has been is
 driven to when an item is missing."""
@@ -44,14 +55,17 @@ driven to when an item is missing."""
 
 def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: str | None) -> Choice:
     """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
-    containers, closed doors; give up when none is left."""
+    containers, closed doors (before a room of a type unlikely to hold the missing items: a car is outside),
+    containers that cannot hold them (:func:`closed_containers`); give up when none is left."""
     goal = agenda.goal
     missing = [
         s for s in lit.args if s != goal.robot and not goal.is_floor(s) and bind(belief, goal, s, sit.xy) is None
     ]
     note = f"looking for {', '.join(goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
-    items = not missing or any(not is_furniture_scope(agenda, s) for s in missing)
-    closed = closed_containers(belief, sit) if items else []
+    items = [s for s in missing if not is_furniture_scope(agenda, s)]
+    searching_items = not missing or bool(items)
+    kept = item_rooms(goal, items)
+    closed, unlikely_containers = closed_containers(belief, sit, agenda, items) if searching_items else ([], [])
     rooms = task_rooms(belief, agenda)
     region = room_to_explore(belief, sit, agenda, missing, rooms)
     if (
@@ -60,40 +74,83 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
-    if items and (region is None or stale(belief, region) or region not in rooms):
+    if searching_items and (region is None or stale(belief, region) or region not in rooms):
         furniture = furniture_to_look_at(belief, sit, rooms)
         if furniture is not None:
             return object_step(sit, "navigate", furniture, note)
         in_task_rooms = [o for o in closed if o.region_id in rooms]
         if in_task_rooms:
             return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
-    if region is not None and not stale(belief, region):
-        return explore_step(sit, region, note)
-    if closed:
-        return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     doors = closed_doors(belief, sit)
-    if doors:
-        return open_to_look(belief, sit, agenda, doors[0].label, held, note)
+    unlikely = region is not None and room_tier(belief, region, kept) == UNLIKELY
+    if region is not None and not stale(belief, region) and not (unlikely and doors):
+        return explore_step(sit, region, note)
+    for pool in (doors, closed) if unlikely else (closed, doors):  # a car is outside: open the way out first
+        if pool:
+            return open_to_look(belief, sit, agenda, pool[0].label, held, note)
     if region is not None:
         return explore_step(sit, region, note)
+    if unlikely_containers:
+        return open_to_look(belief, sit, agenda, unlikely_containers[0].label, held, note)
     why = f"{note}: nothing left to explore or open"
     return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
 
 
-def closed_containers(belief: Belief, sit: Situation) -> list[ObjectNode]:
-    """Closed containers that hold things, not looked into nor given up: the robot's room's first, nearest first."""
+def closed_containers(
+    belief: Belief, sit: Situation, agenda: Agenda, items: Sequence[str]
+) -> tuple[list[ObjectNode], list[ObjectNode]]:
+    """Closed containers that hold things, not looked into nor given up, split into those that may hold
+    one of the missing ``items`` (:func:`container_likelihood`; the robot's room's first, likeliest first,
+    then nearest) and the others (nearest first: opened only when nothing else is left)."""
     here = sit.here
-    return sorted(
-        (
-            o
-            for o in sit.graph.objects.values()
-            if o.open is False
-            and can_hold_things(o.category)
-            and o.label not in belief.looked_into
-            and o.label not in belief.dropped
-        ),
-        key=lambda o: (o.region_id != here, math.dist(o.position[:2], sit.xy), o.label),
+    candidates = [
+        o
+        for o in sit.graph.objects.values()
+        if o.open is False
+        and can_hold_things(o.category)
+        and o.label not in belief.looked_into
+        and o.label not in belief.dropped
+    ]
+    like = {o.label: container_likelihood(agenda, o.category, items) for o in candidates}
+    likely = sorted(
+        (o for o in candidates if like[o.label] > 0),
+        key=lambda o: (o.region_id != here, -like[o.label], math.dist(o.position[:2], sit.xy), o.label),
     )
+    others = sorted(
+        (o for o in candidates if like[o.label] == 0), key=lambda o: (math.dist(o.position[:2], sit.xy), o.label)
+    )
+    return likely, others
+
+
+def container_likelihood(agenda: Agenda, container: str, items: Sequence[str]) -> float:
+    """How likely a closed ``container`` category holds one of the missing ``items`` (scopes), for the
+    order containers are opened in: for an item that fits in it (catalog sizes: a suitcase is in no
+    microwave) and that the corpus does not show as never kept inside anything
+    (:func:`~more_agent.planners.whereabouts.never_inside`), ``UNKNOWN_CONTAINER_SHARE`` plus the share of
+    its evidence inside such containers (:func:`~more_agent.planners.whereabouts.container_prior`); the
+    largest over the items, 0 when none may be inside. With no item named (looking for a room), any may."""
+    if not items:
+        return UNKNOWN_CONTAINER_SHARE
+    best = 0.0
+    activity = agenda.goal.activity
+    for scope in items:
+        synset = scope_synset(scope)
+        if not fits(agenda.goal.categories.get(scope, frozenset()), container) or never_inside(synset, activity):
+            continue
+        share = container_share(container, container_prior(synset, activity))
+        best = max(best, UNKNOWN_CONTAINER_SHARE + share)
+    return best
+
+
+def fits(categories: frozenset[str], container: str) -> bool:
+    """Whether an object of one of ``categories`` fits in a ``container`` (sorted extents, catalog medians);
+    True when a size is unknown."""
+    sized = _sized()
+    if container not in sized:
+        return True
+    room = sorted(category_size(container))
+    item_sizes = [sorted(category_size(c)) for c in categories if c in sized]
+    return not item_sizes or any(all(a <= b for a, b in zip(size, room)) for size in item_sizes)
 
 
 def closed_doors(belief: Belief, sit: Situation) -> list[ObjectNode]:
@@ -146,27 +203,58 @@ def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: lis
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
     new last; then the room most likely to hold the missing furniture (by the share of the room type's
     listed objects it makes up, :func:`~more_agent.planners.room_types.listed_share`); then the rooms of
-    the task's items found so far (``rooms``, from :func:`task_rooms`); then the room whose frontiers show
-    the most unseen floor in sensor range (``GAIN_STEP_M2`` steps: a garden or a store is searched through,
-    not left for a closet after a few metres, and a room nearly seen yields to one barely seen); then the
-    nearest."""
+    the task's items found so far (``rooms``, from :func:`task_rooms`); then by :func:`room_tier` for the
+    missing items (a room type where such items are kept, likeliest first: a utility room before a lawn
+    for tools; then rooms of a type not yet known; rooms of an unlikely type last); then the room whose
+    frontiers show the most unseen floor in sensor range (``GAIN_STEP_M2`` steps: a garden or a store is
+    searched through, not left for a closet after a few metres, and a room nearly seen yields to one
+    barely seen); then the nearest."""
     cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
+    kept = item_rooms(agenda.goal, [s for s in missing if not is_furniture_scope(agenda, s)])
     open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     gain = unseen_floor(sit, open_regions)
 
-    def score(rid: str) -> tuple[bool, float, bool, int, float, str]:
+    def score(rid: str) -> tuple[bool, float, bool, int, float, int, float, str]:
         kind = belief.room_types.get(rid)
         like = max((listed_share(c, kind) for c in cats), default=0.0) if kind else 0.0
+        tier = room_tier(belief, rid, kept)
         return (
             stale(belief, rid),
             -like,
             rid not in rooms,
+            tier,
+            -kept.get(kind or "", 0.0) if tier == LIKELY else 0.0,
             -round(gain[rid] / GAIN_STEP_M2),
             math.dist(sit.graph.regions[rid].centroid, sit.xy),
             rid,
         )
 
     return min(open_regions, key=score) if open_regions else None
+
+
+LIKELY, UNTYPED, UNLIKELY = 0, 1, 2
+"""Room tiers for missing items (:func:`room_tier`)."""
+
+
+def room_tier(belief: Belief, region: str, kept: dict[str, float]) -> int:
+    """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing items'
+    evidence and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the lawn that holds a
+    fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its type is unknown
+    or the items have no evidence (``kept`` empty: every room as likely)."""
+    kind = belief.room_types.get(region)
+    if not kept or kind is None:
+        return UNTYPED
+    share = kept.get(kind, 0.0)
+    return LIKELY if share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * max(kept.values()) else UNLIKELY
+
+
+def item_rooms(goal: TaskGoal, items: Sequence[str]) -> dict[str, float]:
+    """Room type -> where the missing ``items`` (scopes) are kept: the mean of their room priors
+    (:func:`~more_agent.planners.whereabouts.room_prior`, the goal's own activity left out) over the items
+    that have evidence; {} when none has."""
+    priors = [p for p in (room_prior(scope_synset(s), goal.activity) for s in items) if p]
+    kinds = {kind for p in priors for kind in p}
+    return {kind: sum(p.get(kind, 0.0) for p in priors) / len(priors) for kind in kinds}
 
 
 def unseen_floor(sit: Situation, regions: Sequence[str]) -> dict[str, float]:
@@ -181,6 +269,12 @@ def unseen_floor(sit: Situation, regions: Sequence[str]) -> dict[str, float]:
     for (rid, _), g in zip(frontiers, gain):
         best[rid] = max(best[rid], float(g))
     return best
+
+
+@cache
+def _sized() -> frozenset[str]:
+    """The categories the catalog has sizes for."""
+    return frozenset(sized_categories())
 
 
 def task_rooms(belief: Belief, agenda: Agenda) -> set[str]:

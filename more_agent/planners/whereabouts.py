@@ -1,0 +1,148 @@
+"""Where an item is usually kept: which room types, inside which containers.
+
+Commonsense a language model brings to a search ("tools are in the utility room or the garage, on a
+workbench"; "a suitcase is in no kitchen cabinet"; "a car is outside"), made deterministic for the
+planner that runs without one. It is read from bddl's 1016 activity definitions: their initial states
+say where each item starts (``(ontop item furniture)``, ``(inside item container)``, items on items)
+and in which room type each piece of furniture stands (``(inroom furniture room_type)``). Each item
+placed so is one piece of evidence: (item synset, room type, the synset it rests on or in, whether
+inside).
+
+The evidence of the activity being played is left out (leave-one-out: a planner never reads its own
+task's initial state). A synset with too little evidence of its own borrows its parent's in the
+taxonomy (every synset the corpus places under it), up to ``MAX_LEVELS`` generations up; beyond that
+there is no prior and the search ranks as it would without one. Parsed once per process (about a
+second), on first use.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from more_agent.sim import catalog
+
+MIN_EVIDENCE = 1
+"""Items placed in other activities below which a synset borrows its parents' evidence (its siblings')."""
+
+MAX_LEVELS = 1
+"""How many generations up the taxonomy a synset may borrow evidence from: a drill's siblings are hand
+tools; two generations up, every tool, a kitchen's ladles among them."""
+
+NEVER_INSIDE_ACTIVITIES = 3
+"""Activities placing an item, none of them inside anything, that make it one never kept in a container."""
+
+PLACEMENTS = ("ontop", "inside", "under", "nextto")
+"""Init predicates that place an item relative to another object."""
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """One item's initial placement in one activity."""
+
+    activity: str
+    room_type: str | None
+    """The room type of the furniture it ends up on or in (None when the chain reaches no ``inroom``)."""
+    support: str
+    """The synset of the object it rests on or in directly."""
+    inside: bool
+
+
+def scope_synset(scope: str) -> str:
+    """'apple.n.01_1' -> 'apple.n.01'."""
+    return scope.lstrip("?").rsplit("_", 1)[0]
+
+
+@cache
+def corpus() -> dict[str, tuple[Evidence, ...]]:
+    """Item synset -> its evidence over every bddl activity (read with bddl's own parser: static knowledge
+    of the library, not the episode's task, which planners may not import)."""
+    from bddl.config import ACTIVITY_CONFIGS_PATH
+    from bddl.parsing import parse_domain, parse_problem
+
+    domain, *_ = parse_domain("omnigibson")
+    found: dict[str, list[Evidence]] = {}
+    for name in sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir()):
+        init = parse_problem(name, 0, domain)[2]
+        for synset, ev in _activity_evidence(name, init):
+            found.setdefault(synset, []).append(ev)
+    return {s: tuple(evs) for s, evs in found.items()}
+
+
+def _activity_evidence(name: str, parsed: list[Any]) -> list[tuple[str, Evidence]]:
+    """(item synset, evidence) for each item the activity's initial state (``parsed``) places on or in something."""
+    init = [lit for lit in parsed if lit and isinstance(lit[0], str)]
+    room = {lit[1]: lit[2] for lit in init if lit[0] == "inroom" and len(lit) == 3}
+    rests = {lit[1]: (lit[0], lit[2]) for lit in init if lit[0] in PLACEMENTS and len(lit) == 3}
+    out = []
+    for item, (predicate, support) in rests.items():
+        if item in room:
+            continue  # furniture beside furniture: not an item
+        seen, at = {item}, support
+        while at not in room and at in rests and at not in seen:  # a book on a box on a shelf
+            seen.add(at)
+            at = rests[at][1]
+        ev = Evidence(name, room.get(at), scope_synset(support), predicate == "inside")
+        out.append((scope_synset(item), ev))
+    return out
+
+
+@cache
+def _pooled() -> dict[str, tuple[Evidence, ...]]:
+    """Synset -> the evidence of itself and of every corpus synset below it in the taxonomy."""
+    tax = catalog.taxonomy()
+    pooled: dict[str, list[Evidence]] = {}
+    for synset, evs in corpus().items():
+        above = tax.get_ancestors(synset) if tax.is_valid_synset(synset) else set()
+        for s in {synset, *above}:
+            pooled.setdefault(s, []).extend(evs)
+    return {s: tuple(evs) for s, evs in pooled.items()}
+
+
+def evidence(synset: str, leave_out: str = "") -> tuple[Evidence, ...]:
+    """The evidence for ``synset`` outside activity ``leave_out``: its own, else its nearest ancestors'
+    (``MIN_EVIDENCE``, ``MAX_LEVELS``); () when there is too little."""
+    tax = catalog.taxonomy()
+    level = [synset]
+    for _ in range(MAX_LEVELS + 1):
+        evs = tuple(e for s in level for e in _pooled().get(s, ()) if e.activity != leave_out)
+        if len(evs) >= MIN_EVIDENCE:
+            return evs
+        level = sorted({p for s in level if tax.is_valid_synset(s) for p in tax.get_parents(s)})
+    return ()
+
+
+def room_prior(synset: str, leave_out: str = "") -> dict[str, float]:
+    """Room type -> share of the activities (each weighing one, however many items it places) placing
+    the item in such a room ({} without evidence)."""
+    evs = [e for e in evidence(synset, leave_out) if e.room_type]
+    per_activity = Counter(e.activity for e in evs)
+    counts: dict[str, float] = {}
+    for e in evs:
+        kind = e.room_type or ""
+        counts[kind] = counts.get(kind, 0.0) + 1 / per_activity[e.activity]
+    total = sum(counts.values())
+    return {kind: n / total for kind, n in counts.items()}
+
+
+def container_prior(synset: str, leave_out: str = "") -> dict[str, float]:
+    """Container synset -> share of the item's evidence placing it inside one ({} without such evidence)."""
+    evs = evidence(synset, leave_out)
+    counts = Counter(e.support for e in evs if e.inside)
+    return {support: n / len(evs) for support, n in counts.items()}
+
+
+def never_inside(synset: str, leave_out: str = "") -> bool:
+    """Whether at least ``NEVER_INSIDE_ACTIVITIES`` activities place the item and none inside anything: a
+    car, a bow, a branch is kept in no container. Thinner evidence says nothing (containers in the corpus
+    are named finely: a grocery store's fridge is no kitchen's)."""
+    evs = evidence(synset, leave_out)
+    return len({e.activity for e in evs}) >= NEVER_INSIDE_ACTIVITIES and not any(e.inside for e in evs)
+
+
+def container_share(category: str, prior: dict[str, float]) -> float:
+    """Share of an item's evidence inside containers that the object ``category`` is (or descends from)."""
+    return sum(share for support, share in prior.items() if catalog.descends_from(category, frozenset({support})))
