@@ -41,8 +41,9 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
 
 def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> str | None:
     """A reachable region whose room type is the floor's (the robot's when the description names none); with
-    none of that type, the region where an object the description says stays on that floor was found
-    (``TaskGoal.stays``: Ihlen_0_int's garage holds a bookcase and a cabinet, no furniture of a garage)."""
+    none of that type, the region where an object the description says stays on that floor was last seen
+    (``TaskGoal.stays``: Ihlen_0_int's garage holds a bookcase and a cabinet, no furniture of a garage). Last
+    seen, not first: a carton first glimpsed through a doorway is given the room the robot looks from."""
     goal = agenda.goal
     want = goal.floor_rooms.get(scope)
     if want is None:
@@ -50,8 +51,9 @@ def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> 
     matches = sorted(rid for rid, kind in belief.room_types.items() if kind == want)
     if matches:
         return matches[0]
-    found = (belief.found_in.get(belief.bound.get(s, "")) for s, floor in sorted(goal.stays.items()) if floor == scope)
-    return next((rid for rid in found if rid is not None), None)
+    staying = (belief.bound.get(s, "") for s, floor in sorted(goal.stays.items()) if floor == scope)
+    regions = (belief.seen[label].region_id for label in staying if label in belief.seen)
+    return next((rid for rid in regions if rid is not None), None)
 
 
 def closes(lit: Literal) -> bool:
