@@ -556,6 +556,14 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # untyped before unlikely
     belief.room_types[far] = "kitchen"
     assert room_to_explore(belief, sit, agenda, [sack], set()) == far  # a likely type before an untyped room
+    # the item before the furniture it goes in: weeds on the lawn, not in the bathroom that lists a trash can
+    # (hoe_weeds seed 2 opened ovens and washers looking for the trash can and the weeds together)
+    can = "trash_can.n.01_1"
+    both = with_goal(agenda, categories={**agenda.goal.categories, can: frozenset({"trash_can"})})
+    belief.room_types = {here: "kitchen", far: "bathroom"}
+    assert listed_share("trash_can", "bathroom") > listed_share("trash_can", "kitchen") == 0.0
+    assert room_to_explore(belief, sit, both, [can], set()) == far  # the trash can alone: its room
+    assert room_to_explore(belief, sit, both, [sack, can], set()) == here  # with the sack: the sack's room
 
 
 def test_containers_too_small_or_never_holding_the_missing_item_are_opened_last() -> None:

@@ -201,11 +201,13 @@ def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, hel
 
 def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: list[str], rooms: set[str]) -> str | None:
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
-    new last; then the room most likely to hold the missing furniture (by the share of the room type's
-    listed objects it makes up, :func:`~more_agent.planners.room_types.listed_share`); then the rooms of
-    the task's items found so far (``rooms``, from :func:`task_rooms`); then by :func:`room_tier` for the
-    missing items (a room type where such items are kept, likeliest first: a utility room before a lawn
-    for tools; then rooms of a type not yet known; rooms of an unlikely type last); then the room whose
+    new last; then by :func:`room_tier` for the missing items (a room type where such items are kept:
+    a utility room before a lawn for tools; then rooms of a type not yet known; rooms of an unlikely type
+    last: the item is needed before a place to put it, and weeds are looked for on the lawn, not in the
+    bathrooms that list the trash can they go in); then the room most likely to hold the missing furniture
+    (by the share of the room type's listed objects it makes up,
+    :func:`~more_agent.planners.room_types.listed_share`); then the rooms of the task's items found so far
+    (``rooms``, from :func:`task_rooms`); then the likeliest type for the items; then the room whose
     frontiers show the most unseen floor in sensor range (``GAIN_STEP_M2`` steps: a garden or a store is
     searched through, not left for a closet after a few metres, and a room nearly seen yields to one
     barely seen); then the nearest."""
@@ -214,15 +216,15 @@ def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: lis
     open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     gain = unseen_floor(sit, open_regions)
 
-    def score(rid: str) -> tuple[bool, float, bool, int, float, int, float, str]:
+    def score(rid: str) -> tuple[bool, int, float, bool, float, int, float, str]:
         kind = belief.room_types.get(rid)
         like = max((listed_share(c, kind) for c in cats), default=0.0) if kind else 0.0
         tier = room_tier(belief, rid, kept)
         return (
             stale(belief, rid),
+            tier,
             -like,
             rid not in rooms,
-            tier,
             -kept.get(kind or "", 0.0) if tier == LIKELY else 0.0,
             -round(gain[rid] / GAIN_STEP_M2),
             math.dist(sit.graph.regions[rid].centroid, sit.xy),
