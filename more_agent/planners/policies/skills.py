@@ -47,7 +47,7 @@ def _drive(
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
-        path, index = _plan(body, occupancy, goals, snap_m)
+        path, index = plan_path(body, occupancy, goals, snap_m)
         if index is None:  # once per drive: a way back walked again would lead into the nook again
             way = None if retraced else way_back(body, occupancy, goals, snap_m)
             if way is None:
@@ -137,17 +137,21 @@ def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
             yield way
 
 
-def _plan(
+def plan_path(
     body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float
 ) -> tuple[PathResult, int | None]:
     """Shortest path on the agent's map to the nearest reachable goal; when none is, the same with the
-    robot retracing its own path (``agent_nav_grid``'s ``retrace``): paths keep the full clearance
-    margin wherever they can, and the robot is never sealed in where a final approach left it."""
+    robot retracing its own path (``agent_nav_grid``'s ``retrace``), then with the clearance of the base
+    itself (``ROBOT.radius_m``, the world's rule) rather than the planning margin on top: paths keep the
+    full clearance wherever they can, the robot is never sealed in where a final approach left it, and a
+    gap the base fits through on the map is not closed by the margin (a gap 0.4-0.5 m wide on the map
+    hid the hall of packing_fishing_gear_into_car seed 0)."""
     cfg = body.config
-    for retrace in (False, True):
+    tight = min(cfg.plan_inflation_m, ROBOT.radius_m)
+    for inflation, retrace in ((cfg.plan_inflation_m, False), (cfg.plan_inflation_m, True), (tight, True)):
         grid = agent_nav_grid(
             occupancy,
-            inflation_m=cfg.plan_inflation_m,
+            inflation_m=inflation,
             stood_xy=body.trajectory,
             blind_radius_m=cfg.blind_radius_m,
             bumped_xy=body.bumps,
