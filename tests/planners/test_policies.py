@@ -19,7 +19,14 @@ from more_agent.planners.policies import (
     pick_target,
 )
 from more_agent.planners.policies.embodiment import PolicyConfig
-from more_agent.planners.policies.skills import BACK_OUT_M, back_out, place_on_floor
+from more_agent.planners.policies.skills import (
+    BACK_OUT_M,
+    RETRACE_M,
+    back_out,
+    place_on_floor,
+    plan_path,
+    way_back,
+)
 from more_agent.records import FailureReason
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim.env import SimRobot
@@ -201,6 +208,54 @@ def test_a_robot_blocked_in_a_slot_backs_out_through_the_exact_positions_it_came
     assert not back_out(outside, occupancy) and not outside.driven  # type: ignore[arg-type]
     deep = [(2.1 + 0.07 * k, 1.03) for k in range(int(BACK_OUT_M / 0.07) + 5)]
     assert not back_out(DrivenBody(deep), occupancy)  # type: ignore[arg-type]
+
+
+def test_a_robot_its_map_walls_in_retraces_the_exact_way_it_drove_in() -> None:
+    """A final approach drove the base over items on the floor (the world's base meets only furniture
+    and walls): its map shows them across its way in, and no path on the map leads out. The way back
+    runs backwards through the exact positions it held to the first from which the map leads on; none
+    when the goal is out of reach from everywhere it drove, or the way in is longer than ``RETRACE_M``."""
+    grid = np.full((60, 20), FREE)  # [ix, iy], 0.1 m cells: one corridor, open floor
+    grid[30:33, :] = OCCUPIED  # items across the corridor, mapped once the base had driven over them
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    way_in = [(1.0 + 0.075 * k, 1.03) for k in range(60)]  # from x = 1 m across the items to x = 5.4 m
+    body = DrivenBody(list(way_in))
+    goal = [(0.5, 1.0)]
+    sealed = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=way_in, retrace=True)
+    assert path_to_nearest(sealed, body.xy, goal, snap_m=0.5)[1] is None  # its own map seals it in
+    way = way_back(body, occupancy, goal, 0.5)  # type: ignore[arg-type]
+    assert way is not None and way == [way_in[-1], *way_in[::-1][1 : len(way)]]  # the positions held, backwards
+    assert sealed.is_free(*way[-1]) and way[-1][0] < 3.0 <= way[-2][0]  # the first position past the items
+    assert way_back(body, occupancy, [(5.5, 1.0)], 0.5) is None  # type: ignore[arg-type]  # reachable: no way back
+    assert way_back(body, occupancy, [(1.0, 5.0)], 0.5) is None  # type: ignore[arg-type]  # out of reach anyway
+    long_way = [(1.0 + 0.075 * k, 1.03) for k in range(-int(RETRACE_M / 0.075) - 40, 60)]
+    far = agent_nav_grid(occupancy, inflation_m=0.25, stood_xy=long_way, retrace=True)
+    assert path_to_nearest(far, long_way[-1], goal, snap_m=0.5)[1] is None
+    assert way_back(DrivenBody(long_way), occupancy, [(-RETRACE_M, 1.0)], 0.5) is None  # type: ignore[arg-type]
+
+
+def test_a_gap_the_base_fits_through_is_not_closed_by_the_planning_margin() -> None:
+    """A doorway 0.45 m wide on the map: the base (0.2 m radius) fits, the full clearance (0.25 m) does
+    not. Paths keep the full clearance where they can and fall back to the base's own radius only when
+    no goal is reachable otherwise; a gap narrower than the base stays closed."""
+    grid = np.full((80, 40), FREE)  # [ix, iy], 0.05 m cells
+    grid[38:42, :] = OCCUPIED  # a wall at x = 1.9..2.1 m
+    grid[38:42, 10:19] = FREE  # a doorway 0.45 m wide (y = 0.5..0.95 m)
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.05)
+    body = DrivenBody([(1.0, 0.725)])
+    assert path_to_nearest(agent_nav_grid(occupancy, inflation_m=0.25), body.xy, [(3.0, 0.725)], snap_m=0.3)[1] is None
+    path, index = plan_path(body, occupancy, [(3.0, 0.725)], 0.3)  # type: ignore[arg-type]
+    assert index == 0 and path.found and path.waypoints[-1][0] > 2.5
+    grid[38:42, 25:40] = FREE  # a wide opening too (y = 1.25..2 m): the path keeps the full clearance through it
+    wide = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.05)
+    path, index = plan_path(body, wide, [(3.0, 0.725)], 0.3)  # type: ignore[arg-type]
+    crossing = next((a, b) for a, b in zip(path.waypoints, path.waypoints[1:], strict=False) if a[0] < 2.0 <= b[0])
+    (xa, ya), (xb, yb) = crossing
+    assert index == 0 and ya + (yb - ya) * (2.0 - xa) / (xb - xa) > 1.25 + 0.25
+    grid[38:42, 10:40] = OCCUPIED
+    grid[38:42, 11:18] = FREE  # 0.35 m: narrower than the base
+    narrow = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.05)
+    assert plan_path(body, narrow, [(3.0, 0.725)], 0.3)[1] is None  # type: ignore[arg-type]
 
 
 def test_the_graph_shows_the_hand_empty_right_after_a_floor_placement() -> None:

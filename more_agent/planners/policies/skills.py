@@ -15,7 +15,10 @@ Planners run a decided skill with :func:`run_skill`, which looks the skill up in
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+
+import numpy as np
+from scipy import ndimage
 
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
@@ -40,13 +43,20 @@ def _drive(
     goal index, failure feedback)."""
     cfg = body.config
     snap_m = cfg.goal_snap_m if snap_m is None else snap_m
-    occupancy = graph.occupancy
+    occupancy, retraced = graph.occupancy, False
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
-        path, index = _plan(body, occupancy, goals, snap_m)
-        if index is None:
-            return False, None, "no path on the map"
+        path, index = plan_path(body, occupancy, goals, snap_m)
+        if index is None:  # once per drive: a way back walked again would lead into the nook again
+            way = None if retraced else way_back(body, occupancy, goals, snap_m)
+            if way is None:
+                return False, None, "no path on the map"
+            retraced = True
+            if not body.follow(way):
+                return False, None, "the way back is blocked"
+            occupancy = body.build().occupancy
+            continue
         if body.follow(path.waypoints):
             return True, index, ""
         occupancy = body.build().occupancy
@@ -76,29 +86,72 @@ def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
     )
     if grid.is_free(*body.xy):
         return False
+    way = next((w for w in _ways_back(body, BACK_OUT_M) if grid.is_free(*w[-1])), None)
+    return way is not None and body.follow(way)
+
+
+RETRACE_M = 12.0
+"""How far back along its own way the robot retraces, at most, to a place from which its map leads on."""
+
+
+def way_back(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float) -> list[XY] | None:
+    """When no path on the agent's map leads to any goal: the robot's own way in, walked backwards through
+    the exact positions it held, to the last one (within ``RETRACE_M``) from which a path does lead on.
+    The base drove those positions, and the world's base meets only furniture and walls: a final approach
+    may have driven it over items on the floor, which its map then shows as obstacles across the way it
+    came by (putting_out_condiments seed 2: seven such cells sealed a kitchen). The map keeps them; only
+    the exact way driven is trusted through them. None when no position within reach of it leads on."""
+    cfg = body.config
+    grid = agent_nav_grid(
+        occupancy,
+        inflation_m=cfg.plan_inflation_m,
+        stood_xy=body.trajectory,
+        blind_radius_m=cfg.blind_radius_m,
+        bumped_xy=body.bumps,
+        retrace=True,
+    )
+    parts, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
+    here = grid.snap(*body.xy)
+    tried = {parts[here] if here is not None else 0, 0}
+    for way in _ways_back(body, RETRACE_M):
+        part = parts[grid.cell_at(*way[-1])] if grid.is_free(*way[-1]) else 0
+        if part in tried:
+            continue
+        tried.add(part)
+        if path_to_nearest(grid, way[-1], goals, snap_m=snap_m)[1] is not None:
+            return way
+    return None
+
+
+def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
+    """The robot's way in, walked backwards from where it stands through the exact positions it held: each
+    longer prefix in turn, up to ``max_m`` long."""
     way, length = [body.xy], 0.0
     for xy in reversed(body.trajectory):
-        length += math.dist(xy, way[-1])
-        if length > BACK_OUT_M:
-            return False
-        if math.dist(xy, way[-1]) > 1e-6:
+        step = math.dist(xy, way[-1])
+        length += step
+        if length > max_m:
+            return
+        if step > 1e-6:
             way.append(xy)
-        if grid.is_free(*xy):
-            return body.follow(way)
-    return False
+            yield way
 
 
-def _plan(
+def plan_path(
     body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float
 ) -> tuple[PathResult, int | None]:
     """Shortest path on the agent's map to the nearest reachable goal; when none is, the same with the
-    robot retracing its own path (``agent_nav_grid``'s ``retrace``): paths keep the full clearance
-    margin wherever they can, and the robot is never sealed in where a final approach left it."""
+    robot retracing its own path (``agent_nav_grid``'s ``retrace``), then with the clearance of the base
+    itself (``ROBOT.radius_m``, the world's rule) rather than the planning margin on top: paths keep the
+    full clearance wherever they can, the robot is never sealed in where a final approach left it, and a
+    gap the base fits through on the map is not closed by the margin (a gap 0.4-0.5 m wide on the map
+    hid the hall of packing_fishing_gear_into_car seed 0)."""
     cfg = body.config
-    for retrace in (False, True):
+    tight = min(cfg.plan_inflation_m, ROBOT.radius_m)
+    for inflation, retrace in ((cfg.plan_inflation_m, False), (cfg.plan_inflation_m, True), (tight, True)):
         grid = agent_nav_grid(
             occupancy,
-            inflation_m=cfg.plan_inflation_m,
+            inflation_m=inflation,
             stood_xy=body.trajectory,
             blind_radius_m=cfg.blind_radius_m,
             bumped_xy=body.bumps,
