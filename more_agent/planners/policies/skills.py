@@ -27,7 +27,7 @@ from more_agent.records import FailureReason
 from more_agent.robot import XY, ActionResult
 from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
-from more_agent.sim.paths import PathResult
+from more_agent.sim.paths import NavGrid, PathResult
 from more_agent.skills import Skill, Subpolicy, skill_named
 
 
@@ -76,14 +76,7 @@ def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
     fence), where paths through grid-cell centres graze what the exact way in missed, every move
     blocked. False when the robot stands with full clearance, none lies within ``BACK_OUT_M``, or the
     way back is blocked too."""
-    cfg = body.config
-    grid = agent_nav_grid(
-        occupancy,
-        inflation_m=cfg.plan_inflation_m,
-        stood_xy=body.trajectory,
-        blind_radius_m=cfg.blind_radius_m,
-        bumped_xy=body.bumps,
-    )
+    grid = _nav_grid(body, occupancy)
     if grid.is_free(*body.xy):
         return False
     way = next((w for w in _ways_back(body, BACK_OUT_M) if grid.is_free(*w[-1])), None)
@@ -101,15 +94,7 @@ def way_back(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], sna
     may have driven it over items on the floor, which its map then shows as obstacles across the way it
     came by (putting_out_condiments seed 2: seven such cells sealed a kitchen). The map keeps them; only
     the exact way driven is trusted through them. None when no position within reach of it leads on."""
-    cfg = body.config
-    grid = agent_nav_grid(
-        occupancy,
-        inflation_m=cfg.plan_inflation_m,
-        stood_xy=body.trajectory,
-        blind_radius_m=cfg.blind_radius_m,
-        bumped_xy=body.bumps,
-        retrace=True,
-    )
+    grid = _nav_grid(body, occupancy, retrace=True)
     parts, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
     here = grid.snap(*body.xy)
     tried = {parts[here] if here is not None else 0, 0}
@@ -146,21 +131,30 @@ def plan_path(
     full clearance wherever they can, the robot is never sealed in where a final approach left it, and a
     gap the base fits through on the map is not closed by the margin (a gap 0.4-0.5 m wide on the map
     hid the hall of packing_fishing_gear_into_car seed 0)."""
-    cfg = body.config
-    tight = min(cfg.plan_inflation_m, ROBOT.radius_m)
-    for inflation, retrace in ((cfg.plan_inflation_m, False), (cfg.plan_inflation_m, True), (tight, True)):
-        grid = agent_nav_grid(
-            occupancy,
-            inflation_m=inflation,
-            stood_xy=body.trajectory,
-            blind_radius_m=cfg.blind_radius_m,
-            bumped_xy=body.bumps,
-            retrace=retrace,
-        )
+    full = body.config.plan_inflation_m
+    tight = min(full, ROBOT.radius_m)
+    for inflation, retrace in ((full, False), (full, True), (tight, True)):
+        grid = _nav_grid(body, occupancy, inflation_m=inflation, retrace=retrace)
         path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
         if index is not None:
             break
     return path, index
+
+
+def _nav_grid(
+    body: Embodiment, occupancy: OccupancyMap, inflation_m: float | None = None, retrace: bool = False
+) -> NavGrid:
+    """The agent's navigation grid for ``body`` now: its map, the cells it stood on and bumped into, the
+    planning margin unless ``inflation_m`` says otherwise."""
+    cfg = body.config
+    return agent_nav_grid(
+        occupancy,
+        inflation_m=cfg.plan_inflation_m if inflation_m is None else inflation_m,
+        stood_xy=body.trajectory,
+        blind_radius_m=cfg.blind_radius_m,
+        bumped_xy=body.bumps,
+        retrace=retrace,
+    )
 
 
 def explore(body: Embodiment, graph: SceneGraph, region_id: str, room: str) -> ActionResult:
