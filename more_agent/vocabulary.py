@@ -79,6 +79,11 @@ ROOM_TYPES: tuple[str, ...] = (
 the inventory), sorted. The LLM's room classifier chooses from them."""
 
 
+def scope_synset(scope: str) -> str:
+    """The synset of a bddl scope: 'apple.n.01_1' -> 'apple.n.01' (a '?' of a quantified variable dropped)."""
+    return scope.lstrip("?").rsplit("_", 1)[0]
+
+
 def room_type(room_id: str) -> str:
     """The type of a room by its id: 'kitchen_0' -> 'kitchen' (bddl's room naming)."""
     return room_id.rsplit("_", 1)[0]

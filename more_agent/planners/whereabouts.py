@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from more_agent.sim import catalog
+from more_agent.vocabulary import scope_synset
 
 MIN_EVIDENCE = 1
 """Items placed in other activities below which a synset borrows its parents' evidence (its siblings')."""
@@ -49,11 +50,6 @@ class Evidence:
     support: str
     """The synset of the object it rests on or in directly."""
     inside: bool
-
-
-def scope_synset(scope: str) -> str:
-    """'apple.n.01_1' -> 'apple.n.01'."""
-    return scope.lstrip("?").rsplit("_", 1)[0]
 
 
 @cache
@@ -102,9 +98,11 @@ def _pooled() -> dict[str, tuple[Evidence, ...]]:
     return {s: tuple(evs) for s, evs in pooled.items()}
 
 
+@cache
 def evidence(synset: str, leave_out: str = "") -> tuple[Evidence, ...]:
     """The evidence for ``synset`` outside activity ``leave_out``: its own, else its nearest ancestors'
-    (``MIN_EVIDENCE``, ``MAX_LEVELS``); () when there is too little."""
+    (``MIN_EVIDENCE``, ``MAX_LEVELS``); () when there is too little. Cached: the search asks for every
+    closed container and missing item at every step."""
     tax = catalog.taxonomy()
     level = [synset]
     for _ in range(MAX_LEVELS + 1):

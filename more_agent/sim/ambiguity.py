@@ -19,8 +19,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from more_agent.sim import catalog
-from more_agent.sim.tasks import ParsedLiteral, TaskDefinition, atoms, literal_text, scope_synset
+from more_agent.sim.tasks import ParsedLiteral, TaskDefinition, atoms, literal_text
 from more_agent.sim.world import World
+from more_agent.vocabulary import scope_synset
 
 
 class DescribedTask(Protocol):

@@ -25,8 +25,9 @@ from importlib import resources
 
 from more_agent.errors import unknown_name_error
 from more_agent.sim.ambiguity import ambiguous_in, scope_groups, template_scopes, written_scopes
-from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal, scope_synset
+from more_agent.sim.tasks import TaskDefinition, category_phrase, describe_goal
 from more_agent.sim.world import World
+from more_agent.vocabulary import scope_synset
 
 DESCRIPTION_MODES = ("named", "paper")
 """``named``: the paper's text with what it leaves out and the instances the world makes ambiguous

@@ -59,9 +59,9 @@ from more_agent.sim.tasks import (
     draw_scenes,
     literal_text,
     load_task,
-    scope_synset,
 )
 from more_agent.sim.world import World, WorldObject, floor_name
+from more_agent.vocabulary import scope_synset
 
 PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
 """Init predicates that decide where an item rests, in order of preference."""

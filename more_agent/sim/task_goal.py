@@ -31,8 +31,7 @@ from more_agent.sim import catalog
 from more_agent.sim.ambiguity import described_scopes, scope_categories
 from more_agent.sim.goals import GoalChecker
 from more_agent.sim.instantiate import TaskInstance
-from more_agent.sim.tasks import scope_synset
-from more_agent.vocabulary import FLOOR_SYNSETS
+from more_agent.vocabulary import FLOOR_SYNSETS, scope_synset
 
 _FLOOR = re.compile(r"^the (.+) floor$")
 

@@ -31,6 +31,7 @@ from more_agent.errors import UserError, unknown_name_error
 from more_agent.goal import REARRANGE_PREDICATES
 from more_agent.sim import catalog
 from more_agent.sim.matching import maximum_matching
+from more_agent.vocabulary import scope_synset
 
 TASK_SETS: tuple[str, ...] = ("more-paper", "behavior-rearrange")
 
@@ -79,11 +80,6 @@ class TaskDefinition:
             if lit[0] == "inroom":
                 req.setdefault(lit[2], Counter())[scope_synset(lit[1])] += 1
         return req
-
-
-def scope_synset(scope: str) -> str:
-    """'apple.n.01_1' -> 'apple.n.01'."""
-    return scope.lstrip("?").rsplit("_", 1)[0]
 
 
 def atoms(node: Any) -> Iterator[ParsedLiteral]:

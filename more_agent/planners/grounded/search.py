@@ -17,10 +17,11 @@ from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import is_furniture, listed_share
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior, scope_synset
+from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
 from more_agent.sim.catalog import can_hold_things, category_size, is_surface, sized_categories
+from more_agent.vocabulary import scope_synset
 
 OPENS_BEFORE_EXPLORING = 3
 """Containers opened to look inside, one after the other, before the search explores again."""
