@@ -23,6 +23,7 @@ from more_agent.planners.policies.skills import (
     BACK_OUT_M,
     RETRACE_M,
     back_out,
+    explore_frontiers,
     place_on_floor,
     plan_path,
     way_back,
@@ -122,6 +123,25 @@ def test_explore_reaches_a_frontier_then_reports_none_left() -> None:
     else:
         pytest.fail("explore never ran out of frontiers")
     assert result.reason is FailureReason.INVALID_TARGET and result.low_level_steps == 0
+
+
+def test_explore_looks_from_the_nearest_reachable_spot_when_no_path_leads_to_a_frontier() -> None:
+    _, body, graph = fresh()
+    occupancy = graph.occupancy
+    assert occupancy is not None
+    free = np.argwhere(occupancy.grid == FREE)
+    ix, iy = free[np.argmax(free[:, 0])]
+    edge = (
+        occupancy.origin_xy[0] + (ix + 0.5) * occupancy.resolution_m,
+        occupancy.origin_xy[1] + (iy + 0.5) * occupancy.resolution_m,
+    )
+    beyond = (edge[0] + 2.5, edge[1])  # unknown space 2.5 m past the map's free floor: no path leads there
+    before = body.low_level_steps
+    result = explore_frontiers(body, graph, [beyond], "kitchen_0")
+    assert result.ok, result.feedback
+    assert math.dist(body.xy, beyond) <= body.builder.config.max_range_m
+    assert result.low_level_steps == body.low_level_steps - before >= 11  # drove there, then a full turn
+    assert body.visited_frontiers == [beyond]
 
 
 def test_pick_target_prefers_what_the_skill_can_act_on(

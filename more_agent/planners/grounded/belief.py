@@ -97,14 +97,27 @@ def bind(belief: Belief, goal: TaskGoal, scope: str, xy: XY) -> str | None:
         if named in belief.seen:
             belief.bound[scope] = named
         return belief.bound.get(scope)
-    taken = set(belief.bound.values()) | set(goal.named.values()) | belief.dropped
-    cats = goal.categories.get(scope, frozenset())
-    candidates = [o for o in belief.seen.values() if o.category in cats and o.label not in taken]
+    candidates = _candidates(belief, goal, scope)
     if not candidates:
         return None
     best = min(candidates, key=lambda o: (math.dist(o.position[:2], xy), o.label))
     belief.bound[scope] = best.label
     return best.label
+
+
+def _candidates(belief: Belief, goal: TaskGoal, scope: str) -> list[ObjectNode]:
+    """Observed objects of a category that counts as the (unnamed) ``scope``, not bound to another scope."""
+    taken = set(belief.bound.values()) | set(goal.named.values()) | belief.dropped
+    cats = goal.categories.get(scope, frozenset())
+    return [o for o in belief.seen.values() if o.category in cats and o.label not in taken]
+
+
+def unseen(belief: Belief, goal: TaskGoal, scope: str) -> bool:
+    """Whether no observed object could be bound to ``scope`` yet (:func:`bind` without binding)."""
+    if scope in belief.bound:
+        return False
+    named = goal.named.get(scope)
+    return named not in belief.seen if named is not None else not _candidates(belief, goal, scope)
 
 
 def on_ground(belief: Belief, obj: ObjectNode) -> Relation | None:

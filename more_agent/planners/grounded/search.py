@@ -12,7 +12,7 @@ from more_agent.goal import Literal, TaskGoal
 from more_agent.mapping import visible_unknown_area
 from more_agent.planners.base import DONE, Step
 from more_agent.planners.grounded.agenda import Agenda
-from more_agent.planners.grounded.belief import Belief, bind
+from more_agent.planners.grounded.belief import Belief, bind, unseen
 from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import is_furniture, listed_share
@@ -66,7 +66,11 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     items = [s for s in missing if not is_furniture_scope(agenda, s)]
     searching_items = not missing or bool(items)
     kept = item_rooms(goal, items)
-    closed, unlikely_containers = closed_containers(belief, sit, agenda, items) if searching_items else ([], [])
+    closed, unlikely_containers = (
+        closed_containers(belief, sit, agenda, items + other_missing_items(belief, agenda, items))
+        if searching_items
+        else ([], [])
+    )
     rooms = task_rooms(belief, agenda)
     region = room_to_explore(belief, sit, agenda, missing, rooms)
     if (
@@ -95,6 +99,22 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         return open_to_look(belief, sit, agenda, unlikely_containers[0].label, held, note)
     why = f"{note}: nothing left to explore or open"
     return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+
+
+def other_missing_items(belief: Belief, agenda: Agenda, items: Sequence[str]) -> list[str]:
+    """The goal's other items not seen yet: a container worth opening for one of them is worth opening
+    while looking for ``items`` (the book that may lie in the carton the documents are in)."""
+    goal = agenda.goal
+    scopes = dict.fromkeys(s for lit in agenda.literals for s in lit.args)
+    return [
+        s
+        for s in scopes
+        if s not in items
+        and s != goal.robot
+        and not goal.is_floor(s)
+        and not is_furniture_scope(agenda, s)
+        and unseen(belief, goal, s)
+    ]
 
 
 def closed_containers(

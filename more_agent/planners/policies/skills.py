@@ -164,13 +164,17 @@ def explore(body: Embodiment, graph: SceneGraph, region_id: str, room: str) -> A
 
 def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[XY], room: str) -> ActionResult:
     """Go to the closest of ``candidates`` (frontiers) not explored before, and look around there;
-    ``room`` names the area in the feedback."""
+    ``room`` names the area in the feedback. When no path leads to any of them (unknown space seen only
+    as a strip through a doorway narrower than the robot's clearance on its map), go to the reachable spot
+    nearest one within sensor range and look from there: what lies beyond is in view from it."""
     start = body.low_level_steps
     near = body.config.visited_frontier_m
     frontiers = [f for f in candidates if all(math.dist(f, v) > near for v in body.visited_frontiers)]
     if not frontiers:
         return _fail(FailureReason.INVALID_TARGET, f"no frontier left in {room}")
     reached, index, why = _drive(body, graph, frontiers)
+    if index is None:
+        reached, index, why = _drive(body, graph, frontiers, snap_m=body.builder.config.max_range_m)
     if index is not None:
         body.visited_frontiers.append(frontiers[index])
     if not reached:
