@@ -18,6 +18,9 @@ from more_agent.sim import catalog
 SMOOTHING = 0.5
 """Additive smoothing of the category counts per room type."""
 
+OUTDOOR_ROOM_TYPES = frozenset({"garden"})
+"""BEHAVIOR-1K's room types under the open sky (its scenes' lawns, driveways and yards are all gardens)."""
+
 
 @cache
 def room_type_counts() -> dict[str, Counter[str]]:
@@ -60,6 +63,16 @@ def listed_share(category: str, room_type: str) -> float:
     if not counts or not counts.get(category):
         return 0.0
     return counts[category] / sum(counts.values())
+
+
+def furniture_rooms(categories: Iterable[str]) -> dict[str, float]:
+    """Room type -> the share of the listed pieces of ``categories`` that stand in such rooms (fridges: 0.77 in
+    kitchens, 0.09 in grocery stores): where a missing piece of furniture is likeliest; {} when no scene lists
+    any of them."""
+    cats = set(categories)
+    counts = {kind: sum(n for c, n in listed.items() if c in cats) for kind, listed in room_type_counts().items()}
+    total = sum(counts.values())
+    return {kind: n / total for kind, n in counts.items() if n} if total else {}
 
 
 def likely_room_type(categories: Iterable[str]) -> str | None:

@@ -26,6 +26,7 @@ from more_agent.planners.grounded.belief import (
 from more_agent.planners.grounded.choose import act_for, choose
 from more_agent.planners.grounded.literals import floor_region, holds
 from more_agent.planners.grounded.search import (
+    ELSEWHERE,
     FRUITLESS_EXPLORES,
     LIKELY,
     OPENS_BEFORE_EXPLORING,
@@ -37,6 +38,8 @@ from more_agent.planners.grounded.search import (
     informative,
     is_furniture_scope,
     item_rooms,
+    other_missing_items,
+    room_mass,
     room_tier,
     room_to_explore,
     search,
@@ -53,6 +56,7 @@ from more_agent.planners.room_types import (
     listed_share,
 )
 from more_agent.planners.targets import Area
+from more_agent.planners.whereabouts import never_inside
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
 from more_agent.scene_graph import ObjectNode, RegionNode
@@ -546,7 +550,8 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     sack = "sack.n.01_1"
     kept = item_rooms(agenda.goal, [sack])
     assert kept["kitchen"] > kept["garden"] > 0  # sacks are kept in kitchens, sometimes on a lawn
-    assert room_tier(belief, here, kept) == LIKELY and room_tier(belief, far, kept) == UNLIKELY  # under half as often
+    assert room_tier(belief, here, kept) == LIKELY  # the lawn holds under half as many, and lies outdoors:
+    assert room_tier(belief, far, kept) == ELSEWHERE  # its frontiers lead to more lawn, not to a kitchen
     assert unseen_floor(sit, [here, far])[far] > unseen_floor(sit, [here, far])[here] + 5.0
     assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # the likelier room, nearer and smaller
     assert room_to_explore(belief, sit, agenda, [], set()) == far  # nothing missing: the most unseen floor
@@ -556,14 +561,51 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     assert room_to_explore(belief, sit, agenda, [sack], set()) == here  # untyped before unlikely
     belief.room_types[far] = "kitchen"
     assert room_to_explore(belief, sit, agenda, [sack], set()) == far  # a likely type before an untyped room
-    # the item before the furniture it goes in: weeds on the lawn, not in the bathroom that lists a trash can
-    # (hoe_weeds seed 2 opened ovens and washers looking for the trash can and the weeds together)
-    can = "trash_can.n.01_1"
-    both = with_goal(agenda, categories={**agenda.goal.categories, can: frozenset({"trash_can"})})
-    belief.room_types = {here: "kitchen", far: "bathroom"}
-    assert listed_share("trash_can", "bathroom") > listed_share("trash_can", "kitchen") == 0.0
+    # how many of the missing objects a room type holds decides (room_mass): weeds on the lawn, not in the
+    # bathroom that lists the trash can they go in (hoe_weeds seed 2 opened ovens and washers looking for both)
+    can, weed = "trash_can.n.01_1", "weed.n.01_1"
+    cats = agenda.goal.categories
+    both = with_goal(agenda, categories={**cats, can: frozenset({"trash_can"}), weed: frozenset({"weed"})})
+    belief.room_types = {here: "garden", far: "bathroom"}
+    assert listed_share("trash_can", "bathroom") > listed_share("trash_can", "garden") == 0.0
     assert room_to_explore(belief, sit, both, [can], set()) == far  # the trash can alone: its room
-    assert room_to_explore(belief, sit, both, [sack, can], set()) == here  # with the sack: the sack's room
+    assert room_to_explore(belief, sit, both, [weed, can], set()) == here  # with the weeds: the lawn
+    # beer, kept in gardens more often than in kitchens, and the fridge it goes in: the kitchen; the
+    # lawn, outdoors, after any indoor room (store_beer seed 0 searched a garden for 20 steps)
+    beer, fridge = "beer_bottle.n.01_1", "electric_refrigerator.n.01_1"
+    store = with_goal(agenda, categories={**cats, beer: frozenset({"beer_bottle"}), fridge: frozenset({"fridge"})})
+    belief.room_types = {here: "kitchen", far: "garden"}
+    assert room_to_explore(belief, sit, store, [beer, fridge], set()) == here
+    assert room_tier(belief, far, room_mass(store, [beer, fridge])) == ELSEWHERE
+    belief.room_types[here] = "sauna"
+    assert room_tier(belief, here, room_mass(store, [beer, fridge])) == UNLIKELY
+    assert room_to_explore(belief, sit, store, [beer, fridge], set()) == here  # indoors, unlikely: before the lawn
+
+
+def test_a_container_is_judged_by_every_item_of_the_goal_not_seen_yet() -> None:
+    """The corpus never keeps legal documents inside anything, but the book that goes with them may be;
+    all of them lay in a closed carton beside the car (packing_documents_into_car: the carton was never
+    opened, the search crossing the garden around it for the documents)."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    doc, book, car = "legal_document.n.01_1", "book.n.02_1", "car.n.01_1"
+    cats = {doc: frozenset({"legal_document"}), book: frozenset({"paperback_book"}), car: frozenset({"car"})}
+    packing = replace(
+        with_goal(
+            agenda,
+            categories={**agenda.goal.categories, **cats},
+            moved=frozenset({doc, book}),
+            activity="packing_documents_into_car",
+        ),
+        literals=(Literal("inside", (doc, car)), Literal("inside", (book, car))),
+    )
+    assert never_inside("legal_document.n.01", packing.goal.activity)  # its own activity left out
+    assert other_missing_items(belief, packing, [doc]) == [book]
+    assert container_likelihood(packing, "bottom_cabinet", [doc]) == 0.0
+    assert container_likelihood(packing, "bottom_cabinet", [doc, book]) > 0.0
+    likely, _ = closed_containers(belief, sit, packing, [doc])
+    assert not likely  # the documents alone: every cabinet is left to the end
+    likely, _ = closed_containers(belief, sit, packing, [doc, *other_missing_items(belief, packing, [doc])])
+    assert likely and all(o.region_id == sit.here for o in likely[:1])
 
 
 def test_containers_too_small_or_never_holding_the_missing_item_are_opened_last() -> None:

@@ -22,13 +22,16 @@ Every step (MPC style) it rebuilds the scene graph and:
    does not need (on the floor, or on low standing furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore; none when
-   only furniture is missing), explores the room most likely to hold the missing furniture
-   (BEHAVIOR-1K room inventories), a room where the task's items were found (they are set out
-   together) before the others, then by where the missing items are kept (room types from bddl's
-   activity corpus, the task's own activity left out: :mod:`more_agent.planners.whereabouts`; rooms of
-   an unknown type before rooms of an unlikely one, whose turn waits for the closed doors), then the
+   only furniture is missing), explores first the rooms of the types expected to hold the most of the
+   missing objects (where the missing items are kept, from bddl's activity corpus, the task's own
+   activity left out: :mod:`more_agent.planners.whereabouts`; where the BEHAVIOR-1K inventories list
+   the missing furniture's kind): likely types, then unknown ones, then unlikely ones, whose turn waits
+   for the closed doors, and last an unlikely room on the other side of the walls (a garden when the
+   likeliest type is indoors); then the room most likely to hold the missing furniture (the share of
+   the room type's listed objects), a room where the task's items were found (they are set out
+   together) before the others, then the
    room whose frontiers show the most unseen floor, the nearest; containers are opened likeliest first,
-   those no missing item fits in or is ever kept in last; each explore drives to the frontiers farthest
+   those no missing item of the goal fits in or is ever kept in last; each explore drives to the frontiers farthest
    from the robot's path, of those to the ones with the most unseen floor in sensor range
    (information gain on the robot's own occupancy map). Before the search leaves the rooms where
    the task's items were found (or when their explores reveal nothing new) it drives to their

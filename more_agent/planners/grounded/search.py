@@ -15,7 +15,7 @@ from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief, bind, unseen
 from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
-from more_agent.planners.room_types import is_furniture, listed_share
+from more_agent.planners.room_types import OUTDOOR_ROOM_TYPES, furniture_rooms, is_furniture, listed_share
 from more_agent.planners.targets import Area
 from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior
 from more_agent.robot import XY
@@ -65,7 +65,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     note = f"looking for {', '.join(goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
     items = [s for s in missing if not is_furniture_scope(agenda, s)]
     searching_items = not missing or bool(items)
-    kept = item_rooms(goal, items)
+    mass = room_mass(agenda, missing)
     closed, unlikely_containers = (
         closed_containers(belief, sit, agenda, items + other_missing_items(belief, agenda, items))
         if searching_items
@@ -87,7 +87,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         if in_task_rooms:
             return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
     doors = closed_doors(belief, sit)
-    unlikely = region is not None and room_tier(belief, region, kept) == UNLIKELY
+    unlikely = region is not None and room_tier(belief, region, mass) >= UNLIKELY
     if region is not None and not stale(belief, region) and not (unlikely and doors):
         return explore_step(sit, region, note)
     for pool in (doors, closed) if unlikely else (closed, doors):  # a car is outside: open the way out first
@@ -222,31 +222,30 @@ def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, hel
 
 def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: list[str], rooms: set[str]) -> str | None:
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
-    new last; then by :func:`room_tier` for the missing items (a room type where such items are kept:
-    a utility room before a lawn for tools; then rooms of a type not yet known; rooms of an unlikely type
-    last: the item is needed before a place to put it, and weeds are looked for on the lawn, not in the
-    bathrooms that list the trash can they go in); then the room most likely to hold the missing furniture
+    new last; then by :func:`room_tier` for the missing objects (:func:`room_mass`: a room type where such
+    items are kept or such furniture stands: a utility room before a lawn for tools; then rooms of a type
+    not yet known; rooms of an unlikely type last); then by that mass (weeds are looked for on the lawn,
+    not in the bathrooms that list the trash can they go in; beer and its fridge in a kitchen, not in
+    the garden where beer is as often kept); then the room most likely to hold the missing furniture
     (by the share of the room type's listed objects it makes up,
     :func:`~more_agent.planners.room_types.listed_share`); then the rooms of the task's items found so far
-    (``rooms``, from :func:`task_rooms`); then the likeliest type for the items; then the room whose
-    frontiers show the most unseen floor in sensor range (``GAIN_STEP_M2`` steps: a garden or a store is
-    searched through, not left for a closet after a few metres, and a room nearly seen yields to one
-    barely seen); then the nearest."""
+    (``rooms``, from :func:`task_rooms`); then the room whose frontiers show the most unseen floor in
+    sensor range (``GAIN_STEP_M2`` steps: a garden or a store is searched through, not left for a closet
+    after a few metres, and a room nearly seen yields to one barely seen); then the nearest."""
     cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
-    kept = item_rooms(agenda.goal, [s for s in missing if not is_furniture_scope(agenda, s)])
+    mass = room_mass(agenda, missing)
     open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     gain = unseen_floor(sit, open_regions)
 
-    def score(rid: str) -> tuple[bool, int, float, bool, float, int, float, str]:
+    def score(rid: str) -> tuple[bool, int, float, float, bool, int, float, str]:
         kind = belief.room_types.get(rid)
         like = max((listed_share(c, kind) for c in cats), default=0.0) if kind else 0.0
-        tier = room_tier(belief, rid, kept)
         return (
             stale(belief, rid),
-            tier,
+            room_tier(belief, rid, mass),
+            -mass.get(kind or "", 0.0),
             -like,
             rid not in rooms,
-            -kept.get(kind or "", 0.0) if tier == LIKELY else 0.0,
             -round(gain[rid] / GAIN_STEP_M2),
             math.dist(sit.graph.regions[rid].centroid, sit.xy),
             rid,
@@ -255,20 +254,41 @@ def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: lis
     return min(open_regions, key=score) if open_regions else None
 
 
-LIKELY, UNTYPED, UNLIKELY = 0, 1, 2
-"""Room tiers for missing items (:func:`room_tier`)."""
+LIKELY, UNTYPED, UNLIKELY, ELSEWHERE = 0, 1, 2, 3
+"""Room tiers for missing objects (:func:`room_tier`)."""
 
 
-def room_tier(belief: Belief, region: str, kept: dict[str, float]) -> int:
-    """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing items'
-    evidence and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the lawn that holds a
-    fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its type is unknown
-    or the items have no evidence (``kept`` empty: every room as likely)."""
+def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
+    """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing objects
+    (``mass``, :func:`room_mass`) and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the
+    lawn that holds a fifth as many), ``UNLIKELY`` when its type is known and does not, ``ELSEWHERE`` when
+    besides it lies outdoors and the likeliest type indoors or the other way round (the rooms still unseen
+    that may hold them lie on the other side: a garden's frontiers lead to more lawn, not to the kitchen of
+    the fridge), ``UNTYPED`` when its type is unknown or nothing missing has evidence (``mass`` empty: every
+    room as likely)."""
     kind = belief.room_types.get(region)
-    if not kept or kind is None:
+    if not mass or kind is None:
         return UNTYPED
-    share = kept.get(kind, 0.0)
-    return LIKELY if share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * max(kept.values()) else UNLIKELY
+    share, top = mass.get(kind, 0.0), max(mass, key=lambda k: (mass[k], k))
+    if share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * mass[top]:
+        return LIKELY
+    return ELSEWHERE if (kind in OUTDOOR_ROOM_TYPES) != (top in OUTDOOR_ROOM_TYPES) else UNLIKELY
+
+
+def room_mass(agenda: Agenda, missing: Sequence[str]) -> dict[str, float]:
+    """Room type -> how many of the ``missing`` objects to expect in a room of that type: where the missing
+    items are kept (:func:`item_rooms`, one in all) plus, for each missing piece of furniture, the share of
+    its kind standing in such rooms (:func:`~more_agent.planners.room_types.furniture_rooms`). Beer, kept as
+    often in gardens as in kitchens, and the fridge it goes in: a kitchen; weeds and the trash can that bathrooms
+    list: the lawn."""
+    goal = agenda.goal
+    stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
+    stands = {s: rooms for s, rooms in stands.items() if rooms}  # a fridge: some of its kinds are listed
+    mass = dict(item_rooms(goal, [s for s in missing if s not in stands]))
+    for rooms in stands.values():
+        for kind, share in rooms.items():
+            mass[kind] = mass.get(kind, 0.0) + share
+    return mass
 
 
 def item_rooms(goal: TaskGoal, items: Sequence[str]) -> dict[str, float]:
