@@ -50,6 +50,9 @@ INVALID_SHARE = 0.5
 MANIPULATING = frozenset(s.name for s in SKILLS if s.changes_world)
 """The skills that act on an object (grasp, place, open, close)."""
 
+OPENING = frozenset({"go_to_and_open", "go_to_and_close"})
+"""Manipulating skills that also serve a search: opening a container looks inside it."""
+
 
 def is_reach_failure(action: ActionRecord) -> bool:
     """Whether a failed action failed on the way to its target (no path, blocked), not at it."""
@@ -72,7 +75,8 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
     needed = sorted({o for c in achievable for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     called = {o: labels.label(o) or o for o in needed}
     goal_objects = {o for c in record.goal_conditions for o in c.objects}
-    wrong = _wrong_instances(record.actions, needed, goal_objects, world, labels)
+    opened = {o for c in achievable if c.text.removeprefix("(not ").startswith("(open ") for o in c.objects}
+    wrong = _wrong_instances(record.actions, needed, goal_objects, opened, world, labels)
     if wrong:
         return Failure(cause="wrong_instance", detail=wrong)
     misperceived = _misperceived(record, needed, world, labels)
@@ -111,14 +115,23 @@ def is_modelled(condition: GoalCondition) -> bool:
 
 
 def _wrong_instances(
-    actions: Sequence[ActionRecord], needed: Sequence[str], goal_objects: set[str], world: World, labels: InstanceLabels
+    actions: Sequence[ActionRecord],
+    needed: Sequence[str],
+    goal_objects: set[str],
+    opened: set[str],
+    world: World,
+    labels: InstanceLabels,
 ) -> str:
     """'acted on cup B; the goal needs cup A'-style detail when the robot manipulated another instance of a
-    needed object's category, one the goal does not name at all, but never the needed one; '' otherwise."""
+    needed object's category, one the goal does not name at all, but never the needed one; '' otherwise.
+    Opening or closing counts only for the objects an unmet condition wants open or closed (``opened``):
+    otherwise it is a search looking inside (car B opened for the picnic food while car A is not found)."""
     goal_refs = goal_objects | {labels.label(o) for o in goal_objects if o in world.objects}
-    touched = {a.arguments[-1] for a in actions if a.ok and a.name in MANIPULATING and a.arguments}
+    acted = [a for a in actions if a.ok and a.name in MANIPULATING and a.arguments]
+    used = {a.arguments[-1] for a in acted if a.name not in OPENING}
     for name in needed:
         obj = world.get(name)
+        touched = used | {a.arguments[-1] for a in acted} if name in opened else used
         if labels.label(name) in touched or name in touched:
             continue
         others = sorted(

@@ -57,6 +57,10 @@ def test_each_cause_from_the_trace(world: World, labels: InstanceLabels) -> None
     assert cause(_record(all_goals_met=True)) == "done_not_called"
     assert cause(_record(observed_objects=["bottom_cabinet_0"])) == "never_observed"
     assert cause(_record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)])) == "wrong_instance"
+    looked_inside = _record(actions=[_act("go_to_and_open", "bottom_cabinet B", True)], done_called=True)
+    assert cause(looked_inside) == "done_early"  # opening another cabinet is a search, not the goal's cabinet mistaken
+    opens = GoalCondition(text="(open bottom_cabinet_0)", satisfied=False, objects=["bottom_cabinet_0"])
+    assert cause(_record(actions=looked_inside.actions, goal_conditions=[opens])) == "wrong_instance"
     other_goal = GoalCondition(text="(open bottom_cabinet_1)", satisfied=True, objects=["bottom_cabinet_1"])
     both = _record(actions=[_act("go_to_and_place_inside", "bottom_cabinet B", True)], done_called=True)
     both.goal_conditions.append(other_goal)
