@@ -20,10 +20,9 @@ Every step (MPC style) it rebuilds the scene graph and:
    a region of that room type is known, or the region where it found what the description says stays
    on that floor: until then it searches), put down what the hand holds but
    does not need (on the floor, or on low standing furniture when the goal wants it off that floor);
-4. when a needed object is unseen: opens the closed containers of the robot's room of a kind the
-   corpus keeps a missing item in (openables that hold things, not a laptop; three in a row at most
-   while there is a room to explore; none when only furniture is missing; one the item merely fits in
-   waits until the room is searched through), explores first the rooms of the types expected to hold the most of the
+4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
+   hold things, not a laptop; three in a row at most while there is a room to explore; none when
+   only furniture is missing), explores first the rooms of the types expected to hold the most of the
    missing objects (where the missing items are kept, from bddl's activity corpus, the task's own
    activity left out: :mod:`more_agent.planners.whereabouts`; where the BEHAVIOR-1K inventories list
    the missing furniture's kind): likely types, then unknown ones, then unlikely ones, whose turn waits

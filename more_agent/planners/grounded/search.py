@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from functools import cache
 
 import numpy as np
@@ -66,16 +66,19 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     items = [s for s in missing if not is_furniture_scope(agenda, s)]
     searching_items = not missing or bool(items)
     mass = room_mass(agenda, missing)
-    kept, possible, unlikely_containers = (
+    closed, unlikely_containers = (
         closed_containers(belief, sit, agenda, items + other_missing_items(belief, agenda, items))
         if searching_items
-        else ([], [], [])
+        else ([], [])
     )
-    closed = kept + possible
     rooms = task_rooms(belief, agenda)
     region = room_to_explore(belief, sit, agenda, missing, rooms)
-    if kept and kept[0].region_id == sit.here and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None):
-        return open_to_look(belief, sit, agenda, kept[0].label, held, note)
+    if (
+        closed
+        and closed[0].region_id == sit.here
+        and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
+    ):
+        return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     if searching_items and (region is None or stale(belief, region) or region not in rooms):
         furniture = furniture_to_look_at(belief, sit, rooms)
         if furniture is not None:
@@ -116,14 +119,10 @@ def other_missing_items(belief: Belief, agenda: Agenda, items: Sequence[str]) ->
 
 def closed_containers(
     belief: Belief, sit: Situation, agenda: Agenda, items: Sequence[str]
-) -> tuple[list[ObjectNode], list[ObjectNode], list[ObjectNode]]:
-    """Closed containers that hold things, not looked into nor given up, split three ways (each the robot's
-    room's first, likeliest first, then nearest): those of a kind the corpus keeps one of the missing
-    ``items`` in (:func:`container_likelihood` above ``UNKNOWN_CONTAINER_SHARE``; any one when no item is
-    named), opened as the robot comes by them; those one fits in without such evidence, opened once the
-    room is searched through or when the search leaves the task's rooms (a restaurant kitchen's 17 ovens,
-    jars and fridges were opened for the bowls on the dining-room table, for a cheddar the corpus keeps in
-    fridges only); and the others (nearest first: opened only when nothing else is left)."""
+) -> tuple[list[ObjectNode], list[ObjectNode]]:
+    """Closed containers that hold things, not looked into nor given up, split into those that may hold
+    one of the missing ``items`` (:func:`container_likelihood`; the robot's room's first, likeliest first,
+    then nearest) and the others (nearest first: opened only when nothing else is left)."""
     here = sit.here
     candidates = [
         o
@@ -134,18 +133,14 @@ def closed_containers(
         and o.label not in belief.dropped
     ]
     like = {o.label: container_likelihood(agenda, o.category, items) for o in candidates}
-    kept = UNKNOWN_CONTAINER_SHARE if items else 0.0  # with no item named, any container may hold it
-
-    def ranked(keep: Callable[[float], bool]) -> list[ObjectNode]:
-        chosen = (o for o in candidates if keep(like[o.label]))
-        return sorted(
-            chosen, key=lambda o: (o.region_id != here, -like[o.label], math.dist(o.position[:2], sit.xy), o.label)
-        )
-
+    likely = sorted(
+        (o for o in candidates if like[o.label] > 0),
+        key=lambda o: (o.region_id != here, -like[o.label], math.dist(o.position[:2], sit.xy), o.label),
+    )
     others = sorted(
         (o for o in candidates if like[o.label] == 0), key=lambda o: (math.dist(o.position[:2], sit.xy), o.label)
     )
-    return ranked(lambda p: p > kept), ranked(lambda p: 0 < p <= kept), others
+    return likely, others
 
 
 def container_likelihood(agenda: Agenda, container: str, items: Sequence[str]) -> float:
