@@ -24,7 +24,7 @@ from more_agent.planners.grounded.belief import (
     on_floor_of,
 )
 from more_agent.planners.grounded.choose import act_for, choose
-from more_agent.planners.grounded.literals import floor_region, holds, left_open
+from more_agent.planners.grounded.literals import floor_region, holds
 from more_agent.planners.grounded.search import (
     ELSEWHERE,
     FRUITLESS_EXPLORES,
@@ -371,31 +371,6 @@ def test_when_only_closing_is_left_the_planner_closes() -> None:
     belief, sit, agenda = state(planner_in(kitchen))
     closing = (Literal("open", ("electric_refrigerator.n.01_1",), True), Literal("open", ("cabinet.n.01_1",), True))
     assert choose(belief, sit, replace(agenda, literals=closing)).action.name == "go_to_and_close"
-
-
-def test_close_all_the_cabinets_closes_every_open_one_an_unnamed_scope_may_be() -> None:
-    """(not (open cabinet)) on a cabinet the description does not single out ("close all the cabinets"):
-    every open cabinet the robot knows must be closed, not just the one the scope was bound to
-    (putting_dishes_away_after_cleaning seed 0 closed the nearest and left open the one it looked into)."""
-    belief, sit, agenda = state(planner_in(fresh_kitchen()))
-    seen = sorted(label for label, o in belief.seen.items() if o.category == "bottom_cabinet")[:2]
-    assert len(seen) == 2
-    for label in seen:
-        belief.seen[label] = belief.seen[label].model_copy(update={"open": True})
-    scope = "cabinet.n.01_9"
-    cabinets = with_goal(agenda, categories={**agenda.goal.categories, scope: frozenset({"bottom_cabinet"})})
-    close = replace(cabinets, literals=(Literal("open", (scope,), True),))
-    assert left_open(belief, close, scope) == seen
-    assert holds(belief, sit, close, close.literals[0]) is False
-    bound = belief.bound[scope]
-    belief.seen[bound] = belief.seen[bound].model_copy(update={"open": False})  # the bound one closed ...
-    assert holds(belief, sit, close, close.literals[0]) is False  # ... the other still open
-    choice = act_for(belief, sit, close, close.literals[0], None)
-    assert choice is not None and choice.action.name == "go_to_and_close"
-    assert choice.action.arguments[-1] == next(label for label in seen if label != bound)
-    other = next(label for label in seen if label != bound)
-    belief.seen[other] = belief.seen[other].model_copy(update={"open": False})
-    assert holds(belief, sit, close, close.literals[0]) is True
 
 
 def test_an_object_that_must_leave_the_floor_is_not_picked_up_to_be_put_down_again() -> None:

@@ -12,9 +12,8 @@ Every step (MPC style) it rebuilds the scene graph and:
    nearest unbound instance of a category that counts as the scope's synset; bindings stay;
 2. evaluates every literal of the goal option on what it believes (observed open state and spatial
    relations, its own placements on floors, objects whose box reaches the ground on their room's
-   floor, and what rests on a loose item lying on a floor: ``belief.floor_beneath``; a scope to be
-   closed that the description does not single out, "close all the cabinets", holds when no open object
-   it may be is known: ``literals.left_open``) and calls ``done`` when all hold;
+   floor, and what rests on a loose item lying on a floor: ``belief.floor_beneath``) and calls ``done``
+   when all hold;
 3. otherwise acts for the first literal (oracle order: opening, removals, placements with contents
    before their containers move, closing, the robot's own position) whose objects it knows: open a
    closed container before placing inside, grasp, place (on a floor the description names only once

@@ -3,13 +3,11 @@ the goal's agenda (package docstring, points 2 and 3; the search is :mod:`.searc
 
 from __future__ import annotations
 
-import math
-
 from more_agent.goal import Literal
 from more_agent.planners.base import DONE, Step
 from more_agent.planners.grounded.agenda import Agenda
 from more_agent.planners.grounded.belief import Belief
-from more_agent.planners.grounded.literals import closes, floor_region, holds, left_open
+from more_agent.planners.grounded.literals import closes, floor_region, holds
 from more_agent.planners.grounded.search import search
 from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, floor_step, object_step, put_down, reachable, support_for
@@ -71,11 +69,6 @@ def act_for(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: 
     goal = agenda.goal
     if lit.predicate == "open":
         label = belief.bound[lit.args[0]]
-        if closes(lit) and lit.args[0] not in goal.named:  # close all the cabinets: the nearest open one first
-            near = [o for o in left_open(belief, agenda, lit.args[0]) if o in objects]
-            if not near:
-                return None
-            label = min(near, key=lambda o: (math.dist(belief.seen[o].position[:2], sit.xy), o))
         if label not in objects:
             return None
         if held is not None:

@@ -17,8 +17,6 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
         label = bind(belief, goal, lit.args[0], sit.xy)
         if label is None:
             return None
-        if closes(lit) and lit.args[0] not in goal.named:
-            return not left_open(belief, agenda, lit.args[0])
         return bool(belief.seen[label].open) != lit.negated
     subject, target = lit.args
     if subject == goal.robot:
@@ -61,16 +59,3 @@ def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> 
 def closes(lit: Literal) -> bool:
     """Whether ``lit`` asks for something closed."""
     return lit.predicate == "open" and lit.negated
-
-
-def left_open(belief: Belief, agenda: Agenda, scope: str) -> list[str]:
-    """The observed open objects an unnamed ``scope`` to be closed may be, for "close all the cabinets": any
-    instance of its categories but those bound to a scope the goal wants open. The goal closes one instance
-    the description does not single out (putting_dishes_away_after_cleaning: it bound the nearest cabinet,
-    closed it, and left open the one it had looked into)."""
-    goal = agenda.goal
-    cats = goal.categories.get(scope, frozenset())
-    wanted_open = {
-        belief.bound.get(lit.args[0]) for lit in agenda.literals if lit.predicate == "open" and not lit.negated
-    }
-    return sorted(o.label for o in belief.seen.values() if o.category in cats and o.open and o.label not in wanted_open)
