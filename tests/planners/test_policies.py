@@ -126,6 +126,8 @@ def test_explore_reaches_a_frontier_then_reports_none_left() -> None:
 
 
 def test_explore_looks_from_the_nearest_reachable_spot_when_no_path_leads_to_a_frontier() -> None:
+    """A frontier no path leads to is looked at from the reachable spot nearest it within sensor range
+    (hoe_weeds seed 1 saw the playroom only as a strip through a door, too thin for the base, and gave up)."""
     _, body, graph = fresh()
     occupancy = graph.occupancy
     assert occupancy is not None
