@@ -75,7 +75,7 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
     needed = sorted({o for c in achievable for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     called = {o: labels.label(o) or o for o in needed}
     goal_objects = {o for c in record.goal_conditions for o in c.objects}
-    opened = {o for c in achievable if c.text.removeprefix("(not ").startswith("(open ") for o in c.objects}
+    opened = {o for c in achievable if predicate_of(c) == "open" for o in c.objects}
     wrong = _wrong_instances(record.actions, needed, goal_objects, opened, world, labels)
     if wrong:
         return Failure(cause="wrong_instance", detail=wrong)
@@ -107,11 +107,15 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
 
 
 def is_modelled(condition: GoalCondition) -> bool:
-    """Whether the world models the predicate of a goal condition (its bddl literal, ``(not (p ...))`` or
-    ``(p ...)``); no robot meets one it does not model (``attached``: docs/tasks.md)."""
+    """Whether the world models the predicate of a goal condition; no robot meets one it does not model
+    (``attached``: docs/tasks.md)."""
+    return predicate_of(condition) in PREDICATES
+
+
+def predicate_of(condition: GoalCondition) -> str:
+    """The predicate of a goal condition's bddl literal, ``(not (p ...))`` or ``(p ...)``."""
     words = condition.text.replace("(", " ").split()
-    predicate = words[1] if words[:1] == ["not"] and len(words) > 1 else words[0] if words else ""
-    return predicate in PREDICATES
+    return words[1] if words[:1] == ["not"] and len(words) > 1 else words[0] if words else ""
 
 
 def _wrong_instances(
@@ -128,10 +132,11 @@ def _wrong_instances(
     otherwise it is a search looking inside (car B opened for the picnic food while car A is not found)."""
     goal_refs = goal_objects | {labels.label(o) for o in goal_objects if o in world.objects}
     acted = [a for a in actions if a.ok and a.name in MANIPULATING and a.arguments]
+    every = {a.arguments[-1] for a in acted}
     used = {a.arguments[-1] for a in acted if a.name not in OPENING}
     for name in needed:
         obj = world.get(name)
-        touched = used | {a.arguments[-1] for a in acted} if name in opened else used
+        touched = every if name in opened else used
         if labels.label(name) in touched or name in touched:
             continue
         others = sorted(

@@ -573,7 +573,11 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     # beer, kept in gardens more often than in kitchens, and the fridge it goes in: the kitchen; the
     # lawn, outdoors, after any indoor room (store_beer seed 0 searched a garden for 20 steps)
     beer, fridge = "beer_bottle.n.01_1", "electric_refrigerator.n.01_1"
-    store = with_goal(agenda, categories={**cats, beer: frozenset({"beer_bottle"}), fridge: frozenset({"fridge"})})
+    store = with_goal(
+        agenda,
+        categories={**cats, beer: frozenset({"beer_bottle"}), fridge: frozenset({"fridge"})},
+        activity="store_beer",  # its own evidence left out, as in the episode
+    )
     belief.room_types = {here: "kitchen", far: "garden"}
     assert room_to_explore(belief, sit, store, [beer, fridge], set()) == here
     assert room_tier(belief, far, room_mass(store, [beer, fridge])) == ELSEWHERE
