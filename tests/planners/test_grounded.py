@@ -31,10 +31,12 @@ from more_agent.planners.grounded.search import (
     LIKELY,
     OPENS_BEFORE_EXPLORING,
     UNLIKELY,
+    UNTYPED,
     closed_containers,
     container_likelihood,
     far_frontiers,
     fits,
+    found_rooms,
     informative,
     is_furniture_scope,
     item_rooms,
@@ -56,7 +58,7 @@ from more_agent.planners.room_types import (
     listed_share,
 )
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import never_inside
+from more_agent.planners.whereabouts import never_inside, together_share
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
 from more_agent.scene_graph import ObjectNode, RegionNode
@@ -584,6 +586,72 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     belief.room_types[here] = "sauna"
     assert room_tier(belief, here, room_mass(store, [beer, fridge])) == UNLIKELY
     assert room_to_explore(belief, sit, store, [beer, fridge], set()) == here  # indoors, unlikely: before the lawn
+
+
+def test_where_the_task_s_objects_are_known_to_be_outweighs_where_such_things_are_kept() -> None:
+    """cleaning_up_branches_and_twigs on house_single_floor seed 1: one bddl activity keeps branches in a
+    kitchen, so the search went through 21 rooms of the house, the lawn last, although the description
+    says the trash can stays on the lawn; once the trash can was seen there, it went back indoors for the
+    branches. hoe_weeds seed 2 found a weed on the lawn, then left it to look for the trash can in the
+    kitchen. What the description says and what was found decide; a fridge is where fridges stand."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    here = sit.here
+    assert here is not None
+    belief.room_types = {here: "kitchen", far: "garden"}
+    branch, can, lawn, fridge = "branch.n.02_1", "ashcan.n.01_1", "lawn.n.01_1", "electric_refrigerator.n.01_1"
+    cats = {branch: frozenset({"branch"}), can: frozenset({"trash_can"}), fridge: frozenset({"fridge"})}
+    goal = {"categories": {**agenda.goal.categories, **cats}, "activity": "cleaning_up_branches_and_twigs"}
+    branches = with_goal(agenda, **goal, moved=frozenset({branch, can}), floor_rooms={lawn: "garden"})
+    assert item_rooms(branches.goal, [branch]) == {"kitchen": 1.0}  # all the corpus says
+    assert room_tier(belief, far, room_mass(branches, [branch, can])) == ELSEWHERE
+    told = with_goal(branches, stays={can: lawn})  # "Leave trash_can A on the garden floor."
+    assert room_tier(belief, far, room_mass(told, [branch, can])) == LIKELY
+    assert 0.95 < together_share() < 1.0  # two items of one activity share a room type
+    seen = room_mass(told, [branch], ["garden"])  # the trash can found on the lawn
+    assert room_tier(belief, far, seen) == LIKELY and room_tier(belief, here, seen) == ELSEWHERE
+    told = replace(told, literals=(Literal("inside", (branch, can)), Literal("ontop", (can, lawn))))
+    belief.bound[can], belief.found_in["trash_can A"] = "trash_can A", far
+    assert found_rooms(belief, told) == ["garden"]
+    assert room_to_explore(belief, sit, told, [branch], set()) == far  # not the kitchen beside the robot
+    weeds = with_goal(agenda, **goal, moved=frozenset({"weed.n.01_1"}))  # the trash can is only a target
+    assert room_tier(belief, far, room_mass(weeds, [can], ["garden"])) == LIKELY
+    assert room_mass(weeds, [can]).get("garden", 0.0) == 0.0  # bathrooms list trash cans; gardens none
+    assert room_mass(weeds, [fridge], ["garden"]) == room_mass(weeds, [fridge])  # a fixture stands where it stands
+
+
+def test_a_likely_lawn_waits_for_the_unknown_rooms_when_the_likeliest_type_is_indoors() -> None:
+    """bringing_water seed 1: bottles and a coffee table are missing; a lawn holds enough of both to be likely
+    (0.39 against the living room's 0.61), and the robot crossed it for 22 steps while the living room and
+    the kitchen lay behind doors. Across the walls from the likeliest type, a likely room ranks as an
+    unlikely one (before the unlikely ones, by mass), an unlikely one last; a tie takes neither side."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    here = sit.here
+    assert here is not None
+    mass = {"living_room": 0.61, "kitchen": 0.44, "garden": 0.39, "bedroom": 0.05}
+    belief.room_types = {here: "kitchen", far: "garden"}
+    assert room_tier(belief, here, mass) == LIKELY and room_tier(belief, far, mass) == UNLIKELY
+    belief.room_types = {far: "garden"}  # the robot's room not typed yet: unknown before the likely lawn
+    assert room_tier(belief, here, mass) == UNTYPED
+    assert room_tier(belief, far, {**mass, "garden": 0.2}) == ELSEWHERE
+    assert room_tier(belief, far, {**mass, "garden": 0.61}) == LIKELY  # as likely as the likeliest: no side
+
+
+def test_the_cabinets_of_an_unlikely_room_wait_while_a_likelier_room_is_left_to_explore() -> None:
+    """cleaning_parks seed 1 opened 18 kitchen cabinets for bottles that lay on the lawn. The containers of
+    the robot's room are opened first only when no room of a likelier tier is left to explore."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    here = sit.here
+    assert here is not None
+    unseen = next(lit for lit in agenda.literals if bind(belief, agenda.goal, lit.args[0], sit.xy) is None)
+    assert room_mass(agenda, unseen.args[:1]) == {"grocery_store": 1.0}  # the ground beef, as the corpus has it
+    belief.room_types = {here: "grocery_store"}  # the far room not typed yet
+    assert search(belief, sit, agenda, unseen, None).action.name == "go_to_and_open"
+    belief.room_types = {here: "bathroom"}  # unlikely: the far room may be the store
+    step = search(belief, sit, agenda, unseen, None).action
+    assert step.name == "explore" and step.arguments == (sit.names[far],)
 
 
 def test_a_container_is_judged_by_every_item_of_the_goal_not_seen_yet() -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Sequence
 from functools import cache
 
@@ -17,7 +18,7 @@ from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import OUTDOOR_ROOM_TYPES, furniture_rooms, is_furniture, listed_share
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior
+from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior, together_share
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
 from more_agent.sim.catalog import can_hold_things, category_size, is_scene_fixture, is_surface, sized_categories
@@ -73,10 +74,12 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     )
     rooms = task_rooms(belief, agenda)
     region = room_to_explore(belief, sit, agenda, missing, rooms)
+    likelier = region is not None and not stale(belief, region) and likelier_than_here(belief, sit, region, mass)
     if (
         closed
         and closed[0].region_id == sit.here
         and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
+        and not likelier
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     if searching_items and (region is None or stale(belief, region) or region not in rooms):
@@ -99,6 +102,14 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         return open_to_look(belief, sit, agenda, unlikely_containers[0].label, held, note)
     why = f"{note}: nothing left to explore or open"
     return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
+
+
+def likelier_than_here(belief: Belief, sit: Situation, region: str, mass: dict[str, float]) -> bool:
+    """Whether ``region`` is of a likelier tier for the missing objects than the robot's room (:func:`room_tier`):
+    the cabinets of a room unlikely to hold them wait while a likely room or one of unknown type is left to
+    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn)."""
+    here = sit.here
+    return here is not None and room_tier(belief, region, mass) < room_tier(belief, here, mass)
 
 
 def other_missing_items(belief: Belief, agenda: Agenda, items: Sequence[str]) -> list[str]:
@@ -261,18 +272,23 @@ LIKELY, UNTYPED, UNLIKELY, ELSEWHERE = 0, 1, 2, 3
 def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
     """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing objects
     (``mass``, :func:`room_mass`) and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the
-    lawn that holds a fifth as many), ``UNLIKELY`` when its type is known and does not, ``ELSEWHERE`` when
-    besides it lies outdoors and the likeliest type indoors or the other way round (the rooms still unseen
-    that may hold them lie on the other side: a garden's frontiers lead to more lawn, not to the kitchen of
-    the fridge), ``UNTYPED`` when its type is unknown or nothing missing has evidence (``mass`` empty: every
-    room as likely)."""
+    lawn that holds a fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its
+    type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
+
+    A room on the other side of the walls from the likeliest type (outdoors when it is indoors, or the other
+    way round; a tie takes neither side) ranks one tier lower: a likely one as ``UNLIKELY``, an unlikely one ``ELSEWHERE``, last. The
+    rooms still unseen that may hold the objects lie on the likeliest type's side, and a garden's frontiers lead
+    to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed a lawn for 22 steps, likely
+    for bottles and coffee tables, while the living room and the kitchen lay behind doors not yet opened."""
     kind = belief.room_types.get(region)
     if not mass or kind is None:
         return UNTYPED
-    share, top = mass.get(kind, 0.0), max(mass, key=lambda k: (mass[k], k))
-    if share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * mass[top]:
-        return LIKELY
-    return ELSEWHERE if (kind in OUTDOOR_ROOM_TYPES) != (top in OUTDOOR_ROOM_TYPES) else UNLIKELY
+    share, top = mass.get(kind, 0.0), max(mass.values())
+    likely = share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * top
+    outdoors = kind in OUTDOOR_ROOM_TYPES
+    if max((n for k, n in mass.items() if (k in OUTDOOR_ROOM_TYPES) == outdoors), default=0.0) < top:
+        return UNLIKELY if likely else ELSEWHERE
+    return LIKELY if likely else UNLIKELY
 
 
 def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ()) -> dict[str, float]:
@@ -282,26 +298,41 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     often in gardens as in kitchens, and the fridge it goes in: a kitchen; weeds and the trash can that bathrooms
     list: the lawn.
 
-    What is known of a task's objects counts one each, more than any prior: the room type the description says
-    a missing object stays in ("leave trash can A on the lawn"), and the room types the task's items were
-    ``found`` in (:func:`found_rooms`) while something set out for the task is missing (anything but a scene
-    fixture: the weeds' trash can, not a fridge or a car). A task's objects are set out together: in bddl's
-    activities two placed objects share a room type 98 % of the time (955 of 1016 activities place all of
-    them in one room type), where one activity placing branches in a kitchen is all the corpus says of
-    branches, and bathrooms list more trash cans than gardens do."""
+    What is known beats what is usual. An object the description says stays on a room's floor ("leave trash can
+    A on the lawn") is in such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`),
+    the objects set out with them (items, and furniture that is no scene fixture: the weeds' trash can, not a
+    fridge or a car) are where those were found with the probability that two items of one bddl activity share
+    a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
+    otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
+    list more trash cans than gardens do."""
     goal = agenda.goal
     stays = {s: goal.floor_rooms.get(goal.stays.get(s, "")) for s in missing}
-    stays = {s: kind for s, kind in stays.items() if kind}  # the description says where it is
+    stays = {s: kind for s, kind in stays.items() if kind}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
-    mass = dict(item_rooms(goal, [s for s in missing if s not in stands and s not in stays]))
-    set_out = any(not all(is_scene_fixture(c) for c in goal.categories.get(s, ())) for s in missing)
-    for kind in [*stays.values(), *(found if set_out else ())]:
-        mass[kind] = mass.get(kind, 0.0) + 1.0
-    for rooms in stands.values():
-        for kind, share in rooms.items():
-            mass[kind] = mass.get(kind, 0.0) + share
+    items = [s for s in missing if s not in stands and s not in stays]
+    parts = [({kind: 1.0}, False) for kind in stays.values()]
+    parts += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
+    if items:
+        parts.append((item_rooms(goal, items), any(_set_out(goal, s) for s in items)))
+    together = {kind: n / len(found) for kind, n in Counter(found).items()}
+    mass: dict[str, float] = {}
+    for rooms, with_found in parts:
+        if with_found and together:
+            share = together_share()
+            rooms = {
+                kind: share * together.get(kind, 0.0) + (1 - share) * rooms.get(kind, 0.0)
+                for kind in {*rooms, *together}
+            }
+        for kind, n in rooms.items():
+            mass[kind] = mass.get(kind, 0.0) + n
     return mass
+
+
+def _set_out(goal: TaskGoal, scope: str) -> bool:
+    """Whether the task's objects are set out with ``scope``'s: it is no scene fixture (a trash can, a carton;
+    not a fridge, a car, a shelf)."""
+    return not all(is_scene_fixture(c) for c in goal.categories.get(scope, ()))
 
 
 def item_rooms(goal: TaskGoal, items: Sequence[str]) -> dict[str, float]:
