@@ -59,8 +59,11 @@ def is_reach_failure(action: ActionRecord) -> bool:
     return not action.ok and action.reason in REACH_FAILURES
 
 
-def classify_failure(record: EpisodeRecord, world: World | None, labels: InstanceLabels | None) -> Failure | None:
-    """The failure of a finished episode (None for a success); see the module docstring."""
+def classify_failure(
+    record: EpisodeRecord, world: World | None, labels: InstanceLabels | None, goal_objects: Iterable[str] = ()
+) -> Failure | None:
+    """The failure of a finished episode (None for a success); see the module docstring. ``goal_objects``: the
+    objects any ground option of the goal names (``GoalChecker.objects``), none of them a wrong instance."""
     if record.success:
         return None
     if record.error_kind == "llm":
@@ -74,7 +77,7 @@ def classify_failure(record: EpisodeRecord, world: World | None, labels: Instanc
     achievable = [c for c in unmet if is_modelled(c)]  # seeing or reaching the objects of the others changes nothing
     needed = sorted({o for c in achievable for o in c.objects if o in world.objects and world.get(o).kind != "floor"})
     called = {o: labels.label(o) or o for o in needed}
-    goal_objects = {o for c in record.goal_conditions for o in c.objects}
+    goal_objects = {o for c in record.goal_conditions for o in c.objects} | set(goal_objects)
     opened = {o for c in achievable if predicate_of(c) == "open" for o in c.objects}
     wrong = _wrong_instances(record.actions, needed, goal_objects, opened, world, labels)
     if wrong:

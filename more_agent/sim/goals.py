@@ -26,6 +26,7 @@ from bddl.condition_evaluation import evaluate_state
 from more_agent.errors import UserError
 from more_agent.goal import Literal
 from more_agent.records import GoalCondition
+from more_agent.sim.ambiguity import scope_groups
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.predicates import holds
 from more_agent.sim.world import World
@@ -102,6 +103,10 @@ class GoalChecker:
         """``goal`` replaces the task's parsed goal (a reading of it, ``sim.task_goal``)."""
         self.backend = WorldBackend(instance.world)
         self.scope = instance.scope_objects()
+        ranges = scope_groups(instance.definition.goal, instance.definition.objects)
+        self._ranged = frozenset(
+            self.scope[s].world_name for g in ranges if g.quantifier for s in g.scopes if s in self.scope
+        )
         conds = instance.definition.conditions
         if goal is not None:
             conds = copy.copy(conds)
@@ -126,6 +131,12 @@ class GoalChecker:
     def n_options(self) -> int:
         """Number of ground options bddl produced (at most 20)."""
         return len(self._options)
+
+    @property
+    def objects(self) -> frozenset[str]:
+        """The world objects the goal may use: those some ground option names and every instance a quantifier
+        ranges over (any four of the seven knives; bddl keeps 20 options, which name six of them)."""
+        return self._ranged | {arg for option in self._literals for lit in option for arg in lit.args}
 
     def ground_literals(self, option_index: int) -> list[Literal]:
         """The conjuncts of one ground option, as structured literals over world names."""

@@ -139,3 +139,15 @@ def test_options_are_bddls_where_none_relates_an_object_to_itself(task: str) -> 
     bddl_options = get_ground_goal_state_options(conds, checker.backend, dict(scope), goal)
     ours = [checker.ground_literals(i) for i in range(checker.n_options)]
     assert ours == [[literal_from_parsed(head.body, scope) for head in option] for option in bddl_options]
+    assert checker.objects >= {arg for option in ours for lit in option for arg in lit.args}  # any option's objects
+
+
+def test_the_objects_a_goal_may_use_are_every_instance_its_quantifiers_range_over() -> None:
+    """putting_out_condiments wants any four of seven knives on the table; bddl keeps 20 ground options, which
+    name six. A robot that carried the seventh used no wrong instance (the failure causes read this)."""
+    from more_agent.sim.instantiate import instantiate
+
+    checker = GoalChecker(instantiate("putting_out_condiments", seed=0))
+    named = {arg for i in range(checker.n_options) for lit in checker.ground_literals(i) for arg in lit.args}
+    knives = {name for name in checker.objects if name.startswith("table_knife_")}
+    assert len(knives) == 7 and len(knives & named) == 6
