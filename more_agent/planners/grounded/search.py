@@ -306,12 +306,11 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
     list more trash cans than gardens do."""
     goal = agenda.goal
-    stays = {s: goal.floor_rooms.get(goal.stays.get(s, "")) for s in missing}
-    stays = {s: kind for s, kind in stays.items() if kind}
+    stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
     items = [s for s in missing if s not in stands and s not in stays]
-    parts = [({kind: 1.0}, False) for kind in stays.values()]
+    parts: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
     parts += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
     if items:
         parts.append((item_rooms(goal, items), any(_set_out(goal, s) for s in items)))
