@@ -220,7 +220,7 @@ class SceneGraphBuilder:
         frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
         frontier_node = self._through_openings(rg.graph, rg.labels, keep, rg.frontier_xy, frontier_node, occ, grid)
         is_door = np.array([self._instances[i].category == "door" for i in objects], dtype=bool)
-        assigned = self._doors_to_reach(rg.graph, rg.labels, keep, centres[:, :2], rg.assigned, is_door)
+        assigned = self._within_reach(rg.graph, rg.labels, keep, centres[:, :2], rg.assigned, is_door, blocked, grid)
         return self._assemble(
             replace(rg, assigned=assigned), region_ids, keep, objects, frontier_node, robot, occ, grid
         )
@@ -327,22 +327,37 @@ class SceneGraphBuilder:
                 node[i] = mine[np.argmin(np.linalg.norm(graph.xy[mine] - points[i], axis=1))]
         return node
 
-    @staticmethod
-    def _doors_to_reach(
-        graph: NavGraph, labels: np.ndarray, keep: np.ndarray, xy: np.ndarray, assigned: np.ndarray, doors: np.ndarray
+    def _within_reach(
+        self,
+        graph: NavGraph,
+        labels: np.ndarray,
+        keep: np.ndarray,
+        xy: np.ndarray,
+        assigned: np.ndarray,
+        doors: np.ndarray,
+        blocked: np.ndarray,
+        grid: Grid,
     ) -> np.ndarray:
-        """Region labels with every door whose region is out of reach given the nearest region within reach
-        instead: a door joins two rooms, and once opened its leaf no longer separates them, so Eq. 1 may
-        give it to the room behind, which the robot has not reached; the robot that opened it still sees it
-        from its own side."""
+        """Region labels with every object whose region (Eq. 1) is out of reach given the region within reach
+        of the nearest node that sees it. Eq. 1 gives an object its closest node's region when the nodes near
+        it and near its viewpoint share none, and that node may lie in a pocket the graph cannot enter (beside
+        a car the robot just opened: packing_car_for_trip seed 1 lost the car from its graph there and
+        searched the lawn for it). What is seen only through a wall or a window stays out of reach. A door
+        goes to the nearest region within reach, seen or not: it joins two rooms, and once opened its leaf no
+        longer separates them, so Eq. 1 may give it to the room behind, which the robot has not reached."""
         kept_labels = np.unique(labels[keep & (labels >= 0)])
         reachable = np.flatnonzero(keep & (labels >= 0))
-        lost = np.flatnonzero(doors & ~np.isin(assigned, kept_labels))
+        lost = np.flatnonzero(~np.isin(assigned, kept_labels))
         if lost.size == 0 or reachable.size == 0:
             return assigned
         assigned = assigned.copy()
         for i in lost.tolist():
-            assigned[i] = labels[reachable[np.argmin(np.linalg.norm(graph.xy[reachable] - xy[i], axis=1))]]
+            order = reachable[
+                np.argsort(np.linalg.norm(graph.xy[reachable] - xy[i], axis=1))[: self.config.assignment_k]
+            ]
+            seen = line_of_sight(xy[i], graph.xy[order], blocked, grid)
+            if seen.any() or doors[i]:
+                assigned[i] = labels[order[int(np.argmax(seen))]]
         return assigned
 
     def _stable_ids(self, graph: NavGraph, labels: np.ndarray) -> list[str]:

@@ -208,3 +208,22 @@ def test_the_robots_own_path_keeps_the_rooms_behind_a_gap_the_graph_cannot_pass(
     assert len(_region_at(joined, True)) == 1 and joined.robot.region_id in _region_at(joined, False)
     # A path that crosses a cell occupied now (as through a door closed since) joins nothing.
     assert "table A" not in builder.build((6.0, 2.0), [(2.0, 2.0), (4.02, 0.5), (6.0, 2.0)]).objects
+
+
+def test_an_object_eq_1_puts_out_of_reach_goes_to_a_region_within_reach_that_sees_it() -> None:
+    """Eq. 1 gives an object its closest node's region when no region is near both it and its viewpoint; that
+    node may lie in a pocket the graph cannot enter (beside a car the robot had just opened, which then left
+    its graph: packing_car_for_trip seed 1). A region within reach that sees it takes it; behind a wall it
+    stays out of reach, unless it is a door (the room behind may not be reached yet)."""
+    from more_agent.mapping import NavGraph
+    from more_agent.sim.grid import Grid
+
+    graph = NavGraph(np.array([[1.0, 1.0], [2.0, 1.0], [4.0, 1.0]]), np.array([[0, 1]]), np.array([1.0]))
+    labels, keep = np.array([1, 1, 0]), np.array([True, True, False])  # node 2: a pocket out of reach
+    grid = Grid(origin_xy=(0.0, 0.0), resolution_m=0.1)
+    blocked = np.zeros((60, 30), dtype=bool)
+    blocked[30, 15:] = True  # a wall at x = 3.0 in the north half
+    xy = np.array([[3.9, 1.0], [3.9, 2.5], [3.9, 2.5]])  # in the open by the pocket; behind the wall twice
+    doors = np.array([False, False, True])
+    assigned = new_builder()._within_reach(graph, labels, keep, xy, np.array([0, 0, 0]), doors, blocked, grid)
+    assert assigned.tolist() == [1, 0, 1]

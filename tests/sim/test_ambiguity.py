@@ -49,6 +49,11 @@ def test_the_default_description_states_the_goal_conditions_the_papers_text_leav
     fridge = inst.labels.label(inst.scope["electric_refrigerator.n.01_1"])
     assert f". Close {fridge} when done." in inst.description
     assert "Close" not in instantiate("preparing_lunch_box", seed=0, descriptions="paper").description
+    # the cabinets a forall wants closed are the task's two, not the kitchen's others: a reader closing every
+    # cabinet it looked into ran past the goal (putting_dishes_away_after_cleaning seed 0 left one open)
+    dishes = instantiate("putting_dishes_away_after_cleaning", seed=0)
+    first, other = (dishes.labels.label(dishes.scope[s]) for s in ("cabinet.n.01_1", "cabinet.n.01_*"))
+    assert f"Close {first} and {other} when done." in dishes.description and first != other
 
 
 def test_an_unknown_description_mode_names_the_valid_ones() -> None:
