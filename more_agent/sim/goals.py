@@ -103,11 +103,11 @@ class GoalChecker:
         """``goal`` replaces the task's parsed goal (a reading of it, ``sim.task_goal``)."""
         self.backend = WorldBackend(instance.world)
         self.scope = instance.scope_objects()
-        ranges = scope_groups(instance.definition.goal, instance.definition.objects)
+        conds = instance.definition.conditions
+        ranges = scope_groups(conds.parsed_goal_conditions, conds.parsed_objects)
         self._ranged = frozenset(
             self.scope[s].world_name for g in ranges if g.quantifier for s in g.scopes if s in self.scope
         )
-        conds = instance.definition.conditions
         if goal is not None:
             conds = copy.copy(conds)
             conds.parsed_goal_conditions = goal
