@@ -63,7 +63,8 @@ def classify_failure(
     record: EpisodeRecord, world: World | None, labels: InstanceLabels | None, goal_objects: Iterable[str] = ()
 ) -> Failure | None:
     """The failure of a finished episode (None for a success); see the module docstring. ``goal_objects``: the
-    objects any ground option of the goal names (``GoalChecker.objects``), none of them a wrong instance."""
+    objects the goal may use (``GoalChecker.objects``: any ground option's, any quantifier's range), none of
+    them a wrong instance."""
     if record.success:
         return None
     if record.error_kind == "llm":

@@ -30,10 +30,10 @@ Every step (MPC style) it rebuilds the scene graph and:
    and the room types where the task's items were found, for what is set out with them): likely
    types, then unknown ones, then unlikely ones, whose turn waits for the closed doors; a room on the
    other side of the walls from the likeliest type (a garden when it is indoors) ranks a tier lower,
-   a likely one with the unlikely ones, an unlikely one last; then the room most likely to hold the missing furniture (the share of
-   the room type's listed objects), a room where the task's items were found (they are set out
-   together) before the others, then the
-   room whose frontiers show the most unseen floor, the nearest; containers are opened likeliest first,
+   a likely one with the unlikely ones, an unlikely one last; then the room most likely to hold the
+   missing furniture (the share of the room type's listed objects), a room where the task's items were
+   found (they are set out together) before the others, then the room whose frontiers show the most
+   unseen floor, the nearest; containers are opened likeliest first,
    those no missing item of the goal fits in or is ever kept in last; each explore drives to the frontiers farthest
    from the robot's path, of those to the ones with the most unseen floor in sensor range
    (information gain on the robot's own occupancy map). Before the search leaves the rooms where

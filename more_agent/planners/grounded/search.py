@@ -276,10 +276,11 @@ def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
     type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
 
     A room on the other side of the walls from the likeliest type (outdoors when it is indoors, or the other
-    way round; a tie takes neither side) ranks one tier lower: a likely one as ``UNLIKELY``, an unlikely one ``ELSEWHERE``, last. The
-    rooms still unseen that may hold the objects lie on the likeliest type's side, and a garden's frontiers lead
-    to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed a lawn for 22 steps, likely
-    for bottles and coffee tables, while the living room and the kitchen lay behind doors not yet opened."""
+    way round; a tie takes neither side) ranks one tier lower: a likely one as ``UNLIKELY``, an unlikely one
+    as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on the likeliest type's side,
+    and a garden's frontiers lead to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed
+    a lawn for 22 steps, likely for bottles and coffee tables, while the living room and the kitchen lay
+    behind doors not yet opened."""
     kind = belief.room_types.get(region)
     if not mass or kind is None:
         return UNTYPED
