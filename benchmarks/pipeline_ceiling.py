@@ -12,7 +12,7 @@ the episodes whose description singles out every goal instance (``WorldStats.amb
 empty: no reader can beat chance on the others, docs/tasks.md); then one line per task set with
 the SR and TP gaps, overall and on those episodes. It reads the worlds only through the harness, so it
 runs unchanged on other worlds. Run:
-``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--workers 2] [--limit N]
+``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--first-seed 0] [--workers 2] [--limit N]
 [--start random|random-area|task-room] [--no-distractors] [--descriptions named paper] [--perception gt|noisy[:K=V,...]]``
 (run folders ``<out>/<start>[-no-distractors][/<perception>]/descriptions-<mode>/<task set>/<planner>``, the
 perception part only when not ``gt``; the oracle reads no description and runs in the first mode only). Each line also gives TTC and rTP, and the description modes of its records.
@@ -73,7 +73,8 @@ def _pct(x: float | None) -> float | None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--task-sets", nargs="+", default=["more-paper", "behavior-rearrange"])
-    parser.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 of every task")
+    parser.add_argument("--seeds", type=int, default=3, help="how many seeds of every task, from --first-seed")
+    parser.add_argument("--first-seed", type=int, default=0, help="the first seed (re-measure on unseen seeds)")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--limit", type=int, default=None, help="only the first N tasks of each set")
     parser.add_argument("--out", type=Path, default=Path("runs/pipeline_ceiling"))
@@ -103,7 +104,7 @@ def main() -> None:
                 reads_description = planner != "oracle"
                 run_mode = mode if reads_description else args.descriptions[0]
                 config = RunConfig(
-                    planner=planner, tasks=tasks, seeds=list(range(args.seeds)),
+                    planner=planner, tasks=tasks, seeds=list(range(args.first_seed, args.first_seed + args.seeds)),
                     episode_fn="more_agent.eval.episode:run_episode", workers=args.workers, start=args.start,
                     distractors=args.distractors, descriptions=run_mode, perception=perception,
                     more_agent_version=__version__,
