@@ -1,6 +1,6 @@
 """Placement audit: task items that no camera pose could see or no arm could reach where they were put.
 
-Two defects are counted (docs/benchmarks.md, "Placement audit"):
+Two defects are counted (figures: docs/benchmarks.md, "World"):
 - ``enclosed``: the item's box lies within the box of an object that is not one of its supports
   (a candle inside a TV that stands on the same coffee table); the renderer never draws it.
 - ``out_of_reach``: the item rests higher than ``REACH_TOP_M`` (on top of a 2 m grocery shelf); the

@@ -1,7 +1,7 @@
 """Where items are put: never inside another object's box, never above the arm's reach on a tall shelf.
 
-The two task worlds are the defects the pipeline-ceiling pass found (docs/benchmarks.md, "Placement
-audit"); the hand-built ones pin the rule behind them.
+The two task worlds are the defects the pipeline-ceiling pass found (figures:
+docs/benchmarks.md, "World"); the hand-built ones pin the rule behind them.
 """
 
 from __future__ import annotations
