@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from functools import cache
+from itertools import combinations
 from pathlib import Path
 from typing import Any
 
@@ -118,15 +119,12 @@ def together_share() -> float:
     """How often two items one activity places share a room type, over the pairs of distinct item synsets
     of every activity (0.98 in bddl 3.6: 955 of its 1016 activities place every item in one room type): a
     task's objects are set out together, so one found tells where the others are."""
-    rooms: dict[tuple[str, str], set[str]] = {}
+    rooms: dict[str, dict[str, set[str]]] = {}  # activity -> item synset -> room types
     for synset, evs in corpus().items():
         for e in evs:
             if e.room_type:
-                rooms.setdefault((e.activity, synset), set()).add(e.room_type)
-    per_activity: dict[str, list[set[str]]] = {}
-    for (activity, _), kinds in sorted(rooms.items()):
-        per_activity.setdefault(activity, []).append(kinds)
-    pairs = [bool(a & b) for kinds in per_activity.values() for i, a in enumerate(kinds) for b in kinds[i + 1 :]]
+                rooms.setdefault(e.activity, {}).setdefault(synset, set()).add(e.room_type)
+    pairs = [bool(a & b) for items in rooms.values() for a, b in combinations(items.values(), 2)]
     return sum(pairs) / len(pairs)
 
 

@@ -590,10 +590,10 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
 
 def test_where_the_task_s_objects_are_known_to_be_outweighs_where_such_things_are_kept() -> None:
     """cleaning_up_branches_and_twigs on house_single_floor seed 1: one bddl activity keeps branches in a
-    kitchen, so the search went through 21 rooms of the house, the lawn last, although the description
-    says the trash can stays on the lawn; once the trash can was seen there, it went back indoors for the
-    branches. hoe_weeds seed 2 found a weed on the lawn, then left it to look for the trash can in the
-    kitchen. What the description says and what was found decide; a fridge is where fridges stand."""
+    kitchen, so the search went through the house for 39 steps before it saw the lawn, although the
+    description says the trash can stays on the lawn; once the trash can was seen there, it went back indoors
+    for the branches. hoe_weeds seed 2 found a weed on the lawn, then left it to look for the trash can
+    indoors. What the description says and what was found decide; a fridge is where fridges stand."""
     belief, sit, agenda = state(planner_in(fresh_kitchen()))
     sit, far = with_far_room(sit)
     here = sit.here

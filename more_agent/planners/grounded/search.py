@@ -73,7 +73,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         else ([], [])
     )
     rooms = task_rooms(belief, agenda)
-    region = room_to_explore(belief, sit, agenda, missing, rooms)
+    region = room_to_explore(belief, sit, agenda, missing, rooms, mass)
     likelier = region is not None and not stale(belief, region) and likelier_than_here(belief, sit, region, mass)
     if (
         closed
@@ -231,7 +231,14 @@ def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, hel
     return Choice(object_step(sit, "go_to_and_open", label, note).action, looking=True)
 
 
-def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: list[str], rooms: set[str]) -> str | None:
+def room_to_explore(
+    belief: Belief,
+    sit: Situation,
+    agenda: Agenda,
+    missing: list[str],
+    rooms: set[str],
+    mass: dict[str, float] | None = None,
+) -> str | None:
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
     new last; then by :func:`room_tier` for the missing objects (:func:`room_mass`: a room type where such
     items are kept or such furniture stands: a utility room before a lawn for tools; then rooms of a type
@@ -242,9 +249,10 @@ def room_to_explore(belief: Belief, sit: Situation, agenda: Agenda, missing: lis
     :func:`~more_agent.planners.room_types.listed_share`); then the rooms of the task's items found so far
     (``rooms``, from :func:`task_rooms`); then the room whose frontiers show the most unseen floor in
     sensor range (``GAIN_STEP_M2`` steps: a garden or a store is searched through, not left for a closet
-    after a few metres, and a room nearly seen yields to one barely seen); then the nearest."""
+    after a few metres, and a room nearly seen yields to one barely seen); then the nearest. ``mass``: the
+    step's :func:`room_mass` when the caller has it."""
     cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
-    mass = room_mass(agenda, missing, found_rooms(belief, agenda))
+    mass = room_mass(agenda, missing, found_rooms(belief, agenda)) if mass is None else mass
     open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     gain = unseen_floor(sit, open_regions)
 
