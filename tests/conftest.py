@@ -1,6 +1,7 @@
 """Suite-wide settings: episodes and reports are written without their matplotlib pictures
 (``MORE_AGENT_PICTURES=0``, set here so that ``more-agent`` subprocesses inherit it too), which cost more
-than most fixture episodes; tests that look at a picture ask for ``pictures_on``."""
+than most fixture episodes; tests that look at a picture ask for ``pictures_on``. ``-n auto`` starts one
+pytest-xdist worker more than the machine has cores (``pytest_xdist_auto_num_workers``)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,12 @@ import pytest
 from more_agent.eval.pictures import ENV_PICTURES
 
 os.environ.setdefault(ENV_PICTURES, "0")
+
+
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
+    """One worker per core, and one more: a fifth of the suite's time is spent waiting (on local HTTP
+    servers, subprocesses and signals, deadlines that must pass), time in which another test can run."""
+    return (os.cpu_count() or 1) + 1
 
 
 @pytest.fixture

@@ -13,6 +13,8 @@ whatever a server sends. Imported only when the first request is sent (it import
 
 from __future__ import annotations
 
+import functools
+import ssl
 import threading
 import time
 from collections.abc import Iterable, Iterator
@@ -96,6 +98,13 @@ def _deadline_backend() -> Any:
     return DeadlineBackend()
 
 
+@functools.cache
+def _ssl_context() -> ssl.SSLContext:
+    """httpx's default TLS context, built once per process: loading the CA bundle takes ~25 ms, and every
+    episode's client would do it again (contexts are safe to share between threads)."""
+    return httpx2.create_ssl_context()
+
+
 def bounded_client(timeout_s: float, *, max_body_bytes: int = MAX_BODY_BYTES) -> httpx2.Client:
     """An ``httpx2.Client`` whose requests each end within ``timeout_s`` and read at most ``max_body_bytes``."""
 
@@ -119,7 +128,7 @@ def bounded_client(timeout_s: float, *, max_body_bytes: int = MAX_BODY_BYTES) ->
                 extensions=response.extensions,
             )
 
-    transport = BoundedTransport()
+    transport = BoundedTransport(verify=_ssl_context())
     # httpx builds its connection pool without a choice of network backend; the deadline lives there.
     transport._pool._network_backend = _deadline_backend()  # noqa: SLF001 - checked by tests/llm/test_http_bounds.py
     return httpx2.Client(transport=transport, timeout=timeout_s)

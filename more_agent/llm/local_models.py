@@ -60,6 +60,17 @@ def bundled_model_path(name: str) -> Path:
     raise MissingExtra(f"{model.distribution} is installed but holds no {model.file}; reinstall it: {LOCAL_EXTRA_HINT}")
 
 
-def gguf_path(model: str) -> Path:
-    """The GGUF file of a ``llamacpp:`` spec's model part: a bundled model's file, else the path itself."""
-    return bundled_model_path(model) if is_bundled(model) else Path(model).expanduser()
+def gguf_path(model: str, *, require_installed: bool = True) -> Path:
+    """The GGUF file of a ``llamacpp:`` spec's model part: a bundled model's file, else the path itself.
+
+    ``require_installed=False`` (replay runs, which never load the model) gives a bundled model's file name
+    when its package is not installed, so the replayed answers keep their cache keys.
+    """
+    if not is_bundled(model):
+        return Path(model).expanduser()
+    try:
+        return bundled_model_path(model)
+    except MissingExtra:
+        if require_installed:
+            raise
+        return Path(BUNDLED_MODELS[model.lower()].file)

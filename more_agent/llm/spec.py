@@ -85,8 +85,9 @@ def make_backend(spec: LLMSpec, config: LLMConfig) -> Backend:
         return OpenAIBackend.from_config(spec.model, config, require_key=config.cache_mode is not CacheMode.REPLAY)
     from more_agent.llm.llamacpp_backend import LlamaCppBackend
 
+    generates = config.cache_mode is not CacheMode.REPLAY
     return LlamaCppBackend.from_config(
-        gguf_path(spec.model), config, require_model=config.cache_mode is not CacheMode.REPLAY
+        gguf_path(spec.model, require_installed=generates), config, require_model=generates
     )
 
 

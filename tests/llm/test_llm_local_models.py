@@ -23,6 +23,11 @@ def test_bundled_model_without_its_package_names_the_extra(monkeypatch: pytest.M
     with pytest.raises(MissingExtra, match=r"'more-agent-no-such-dist' package, which is not installed: .*\[local\]"):
         bundled_model_path("ghost")
     assert parse_llm_spec("llamacpp:ghost").model == "ghost"
+    with pytest.raises(MissingExtra):
+        gguf_path("ghost")
+    # A replay never loads the model: it keys its answers by the bundled file's name, installed or not.
+    assert gguf_path("ghost", require_installed=False) == Path("x.gguf")
+    assert make_client("llamacpp:ghost", LLMConfig(cache_mode=CacheMode.REPLAY)).model == "x.gguf"
 
 
 def test_bundled_model_file_missing_from_its_package_is_named(monkeypatch: pytest.MonkeyPatch) -> None:
