@@ -18,6 +18,7 @@ second), on first use.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from itertools import combinations
@@ -156,6 +157,15 @@ def never_inside(synset: str, leave_out: str = "") -> bool:
     return len({e.activity for e in evs}) >= NEVER_INSIDE_ACTIVITIES and not any(e.inside for e in evs)
 
 
-def container_share(category: str, prior: dict[str, float]) -> float:
-    """Share of an item's evidence inside containers that the object ``category`` is (or descends from)."""
-    return sum(share for support, share in prior.items() if catalog.descends_from(category, frozenset({support})))
+def container_share(category: str, prior: dict[str, float], siblings: Sequence[str] = ()) -> float:
+    """Share of an item's evidence inside containers that the object ``category`` is (or descends from).
+
+    ``siblings``: the categories of the containers it stands among (itself included), over which the evidence
+    for a kind of container is spread: one of a kitchen's 14 cabinets is less likely to hold the bottles than
+    its one fridge, though bottles are kept in cabinets a little more often than in fridges."""
+    total = 0.0
+    for support, share in prior.items():
+        kind = frozenset({support})
+        if catalog.descends_from(category, kind):
+            total += share / max(1, sum(catalog.descends_from(c, kind) for c in siblings))
+    return total

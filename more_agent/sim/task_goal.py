@@ -43,8 +43,8 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
     task's scopes); world names in them are mapped back to scope names, so the planner sees the goal
     as written, not which world object a scope is.
     """
-    to_scope = {world: scope for scope, world in instance.scope.items()}
     intended = intended_goal(instance.definition.goal)
+    to_scope = scopes_of_world_names(instance.scope, {t.lstrip("?") for t in _terms(intended)})
     if intended != instance.definition.goal:
         goals = GoalChecker(instance, goal=intended)
     options = tuple(
@@ -84,6 +84,18 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         stays=staying(options, floors, instance.definition.init),
         activity=instance.definition.name,
     )
+
+
+def scopes_of_world_names(scope: dict[str, str], in_goal: set[str]) -> dict[str, str]:
+    """World name -> the scope a goal literal over it is read as. Scopes may share a world object: a garden's
+    ``lawn.n.01_1``, ``floor.n.01_1`` and ``driveway.n.01_1`` are all its one ground. The scope the goal
+    names wins (cleaning_parks' "leave the recycling bin on the lawn" read as on a ``floor.n.01_1`` of no
+    named room lost that the bin stays on the lawn); otherwise the first."""
+    to_scope: dict[str, str] = {}
+    for name, world in scope.items():
+        if world not in to_scope or (name in in_goal and to_scope[world] not in in_goal):
+            to_scope[world] = name
+    return to_scope
 
 
 def staying(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | None], init: list[Any]) -> dict[str, str]:

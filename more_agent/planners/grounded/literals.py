@@ -31,12 +31,21 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
             region = floor_region(belief, sit, agenda, target)
             want = want if region is None else belief.room_types.get(region, "")
         floor = floor_beneath(belief, a)
+        if goal.stays.get(subject) == target and (floor is not None or unplaced(belief, sit, a)):
+            return not lit.negated  # the description says it lies there: wherever seen, however its region is typed
         on = floor is not None and (want is None or floor[1] == f"{FLOOR} {want}")
         return on != lit.negated
     b = bind(belief, goal, target, sit.xy)
     if b is None:
         return None
     return (belief.relation.get(a) == (lit.predicate, b)) != lit.negated
+
+
+def unplaced(belief: Belief, sit: Situation, label: str) -> bool:
+    """Whether ``label`` rests on nothing the robot knows of and is not in its hand: an object seen only in part
+    (a bin's top above a hedge) shows no support and no ground beneath it."""
+    held = sit.graph.held_object
+    return belief.relation.get(label) is None and (held is None or held.label != label)
 
 
 def floor_region(belief: Belief, sit: Situation, agenda: Agenda, scope: str) -> str | None:

@@ -74,12 +74,17 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     )
     rooms = task_rooms(belief, agenda)
     region = room_to_explore(belief, sit, agenda, missing, rooms, mass)
-    likelier = region is not None and not stale(belief, region) and likelier_than_here(belief, sit, region, mass)
+    doors = closed_doors(belief, sit)
+    here_tier = room_tier(belief, sit.here, mass) if sit.here is not None else UNTYPED
+    left = region is not None and not stale(belief, region)
+    likelier = region is not None and left and likelier_than_here(belief, sit, region, mass)
     if (
         closed
         and closed[0].region_id == sit.here
         and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
         and not likelier
+        and not (here_tier >= UNLIKELY and doors)
+        and not (here_tier == ELSEWHERE and left)
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     if searching_items and (region is None or stale(belief, region) or region not in rooms):
@@ -89,11 +94,10 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         in_task_rooms = [o for o in closed if o.region_id in rooms]
         if in_task_rooms:
             return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
-    doors = closed_doors(belief, sit)
     unlikely = region is not None and room_tier(belief, region, mass) >= UNLIKELY
-    if region is not None and not stale(belief, region) and not (unlikely and doors):
+    if region is not None and left and not (unlikely and doors):
         return explore_step(sit, region, note)
-    for pool in (doors, closed) if unlikely else (closed, doors):  # a car is outside: open the way out first
+    for pool in (doors, closed) if unlikely or here_tier >= UNLIKELY else (closed, doors):  # the way out first
         if pool:
             return open_to_look(belief, sit, agenda, pool[0].label, held, note)
     if region is not None:
@@ -107,7 +111,10 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
 def likelier_than_here(belief: Belief, sit: Situation, region: str, mass: dict[str, float]) -> bool:
     """Whether ``region`` is of a likelier tier for the missing objects than the robot's room (:func:`room_tier`):
     the cabinets of a room unlikely to hold them wait while a likely room or one of unknown type is left to
-    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn)."""
+    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn). They also
+    wait while a closed door is left to open (the room behind may be likely: outfit_a_basic_toolbox seed 1
+    opened the kitchen's cabinets for tools that lay in the utility room behind its door), and those of a
+    room of the last tier (``ELSEWHERE``) while any room is left to explore."""
     here = sit.here
     return here is not None and room_tier(belief, region, mass) < room_tier(belief, here, mass)
 
@@ -143,7 +150,11 @@ def closed_containers(
         and o.label not in belief.looked_into
         and o.label not in belief.dropped
     ]
-    like = {o.label: container_likelihood(agenda, o.category, items) for o in candidates}
+    kinds: dict[str | None, list[str]] = {}
+    for o in sit.graph.objects.values():
+        if o.open is not None and can_hold_things(o.category):
+            kinds.setdefault(o.region_id, []).append(o.category)
+    like = {o.label: container_likelihood(agenda, o.category, items, kinds.get(o.region_id, ())) for o in candidates}
     likely = sorted(
         (o for o in candidates if like[o.label] > 0),
         key=lambda o: (o.region_id != here, -like[o.label], math.dist(o.position[:2], sit.xy), o.label),
@@ -154,13 +165,14 @@ def closed_containers(
     return likely, others
 
 
-def container_likelihood(agenda: Agenda, container: str, items: Sequence[str]) -> float:
+def container_likelihood(agenda: Agenda, container: str, items: Sequence[str], siblings: Sequence[str] = ()) -> float:
     """How likely a closed ``container`` category holds one of the missing ``items`` (scopes), for the
     order containers are opened in: for an item that fits in it (catalog sizes: a suitcase is in no
     microwave) and that the corpus does not show as never kept inside anything
     (:func:`~more_agent.planners.whereabouts.never_inside`), ``UNKNOWN_CONTAINER_SHARE`` plus the share of
-    its evidence inside such containers (:func:`~more_agent.planners.whereabouts.container_prior`); the
-    largest over the items, 0 when none may be inside. With no item named (looking for a room), any may."""
+    its evidence inside such containers (:func:`~more_agent.planners.whereabouts.container_prior`), spread over
+    the containers of its room (``siblings``: their categories, its own included); the largest over the items,
+    0 when none may be inside. With no item named (looking for a room), any may."""
     if not items:
         return UNKNOWN_CONTAINER_SHARE
     best = 0.0
@@ -169,7 +181,7 @@ def container_likelihood(agenda: Agenda, container: str, items: Sequence[str]) -
         synset = scope_synset(scope)
         if not fits(agenda.goal.categories.get(scope, frozenset()), container) or never_inside(synset, activity):
             continue
-        share = container_share(container, container_prior(synset, activity))
+        share = container_share(container, container_prior(synset, activity), siblings)
         best = max(best, UNKNOWN_CONTAINER_SHARE + share)
     return best
 
@@ -273,8 +285,8 @@ def room_to_explore(
     return min(open_regions, key=score) if open_regions else None
 
 
-LIKELY, UNTYPED, UNLIKELY, ELSEWHERE = 0, 1, 2, 3
-"""Room tiers for missing objects (:func:`room_tier`)."""
+LIKELY, UNTYPED, UNLIKELY, ACROSS, ELSEWHERE = 0, 1, 2, 3, 4
+"""Room tiers for missing objects (:func:`room_tier`), searched in this order."""
 
 
 def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
@@ -284,11 +296,12 @@ def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
     type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
 
     A room on the other side of the walls from the likeliest type (outdoors when it is indoors, or the other
-    way round; a tie takes neither side) ranks one tier lower: a likely one as ``UNLIKELY``, an unlikely one
-    as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on the likeliest type's side,
-    and a garden's frontiers lead to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed
-    a lawn for 22 steps, likely for bottles and coffee tables, while the living room and the kitchen lay
-    behind doors not yet opened."""
+    way round; a tie takes neither side) ranks after the unlikely rooms on that type's side: a likely one as
+    ``ACROSS``, an unlikely one as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on
+    the likeliest type's side, and a garden's frontiers lead to more lawn, not to the kitchen of the fridge:
+    bringing_water seed 1 crossed a lawn for 22 steps, likely for bottles and coffee tables, while the living
+    room and the kitchen lay behind doors not yet opened, and once they were open it crossed it again rather
+    than explore the private office the kitchen lay behind."""
     kind = belief.room_types.get(region)
     if not mass or kind is None:
         return UNTYPED
@@ -296,7 +309,7 @@ def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
     likely = share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * top
     outdoors = kind in OUTDOOR_ROOM_TYPES
     if max((n for k, n in mass.items() if (k in OUTDOOR_ROOM_TYPES) == outdoors), default=0.0) < top:
-        return UNLIKELY if likely else ELSEWHERE
+        return ACROSS if likely else ELSEWHERE
     return LIKELY if likely else UNLIKELY
 
 
@@ -309,7 +322,7 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
 
     What is known beats what is usual. An object the description says stays on a room's floor ("leave trash can
     A on the lawn") is in such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`),
-    the objects set out with them (items, and furniture that is no scene fixture: the weeds' trash can, not a
+    or the description puts one of them there (the trash can on the lawn), the objects set out with them (items, and furniture that is no scene fixture: the weeds' trash can, not a
     fridge or a car) are where those were found with the probability that two items of one bddl activity share
     a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
     otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
@@ -323,7 +336,8 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     parts += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
     if items:
         parts.append((item_rooms(goal, items), any(_set_out(goal, s) for s in items)))
-    together = {kind: n / len(found) for kind, n in Counter(found).items()}
+    known = [*found, *(kind for s, kind in stays.items() if _set_out(goal, s))]
+    together = {kind: n / len(known) for kind, n in Counter(known).items()}
     mass: dict[str, float] = {}
     for rooms, with_found in parts:
         if with_found and together:
