@@ -22,18 +22,20 @@ Every step (MPC style) it rebuilds the scene graph and:
    does not need (on the floor, or on low standing furniture when the goal wants it off that floor);
 4. when a needed object is unseen: opens the closed containers of the robot's room (openables that
    hold things, not a laptop; three in a row at most while there is a room to explore; none while a
-   room of a likelier tier is left to explore, nor when only furniture is missing), explores first the
+   room of a likelier tier is left to explore, nor when only furniture is missing; in a room of the last
+   tier, none while any room or closed door is left), explores first the
    rooms of the types expected to hold the most of the missing objects (where the missing items are
    kept, from bddl's activity corpus, the task's own activity left out:
    :mod:`more_agent.planners.whereabouts`; where the BEHAVIOR-1K inventories list the missing
    furniture's kind; outweighed by what is known: the room the description says an object stays in,
-   and the room types where the task's items were found, for what is set out with them): likely
-   types, then unknown ones, then unlikely ones, whose turn waits for the closed doors; a room on the
-   other side of the walls from the likeliest type (a garden when it is indoors) ranks a tier lower,
-   a likely one with the unlikely ones, an unlikely one last; then the room most likely to hold the
+   and the room types where the task's items were found or are said to stay, for what is set out with
+   them): likely types, then unknown ones, then unlikely ones, whose turn waits for the closed doors; a
+   room on the other side of the walls from the likeliest type (a garden when it is indoors) ranks after
+   the unlikely ones, a likely one next, an unlikely one last; then the room most likely to hold the
    missing furniture (the share of the room type's listed objects), a room where the task's items were
    found (they are set out together) before the others, then the room whose frontiers show the most
-   unseen floor, the nearest; containers are opened likeliest first,
+   unseen floor, the nearest; containers are opened likeliest first (a kind's evidence spread over the
+   room's containers of that kind),
    those no missing item of the goal fits in or is ever kept in last; each explore drives to the frontiers farthest
    from the robot's path, of those to the ones with the most unseen floor in sensor range
    (information gain on the robot's own occupancy map). Before the search leaves the rooms where

@@ -83,8 +83,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         and closed[0].region_id == sit.here
         and (belief.opened_in_a_row < OPENS_BEFORE_EXPLORING or region is None)
         and not likelier
-        and not (here_tier >= UNLIKELY and doors)
-        and not (here_tier == ELSEWHERE and left)
+        and not (here_tier == ELSEWHERE and (left or doors))
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     if searching_items and (region is None or stale(belief, region) or region not in rooms):
@@ -97,7 +96,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     unlikely = region is not None and room_tier(belief, region, mass) >= UNLIKELY
     if region is not None and left and not (unlikely and doors):
         return explore_step(sit, region, note)
-    for pool in (doors, closed) if unlikely or here_tier >= UNLIKELY else (closed, doors):  # the way out first
+    for pool in (doors, closed) if unlikely or here_tier == ELSEWHERE else (closed, doors):  # the way out first
         if pool:
             return open_to_look(belief, sit, agenda, pool[0].label, held, note)
     if region is not None:
@@ -111,10 +110,9 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
 def likelier_than_here(belief: Belief, sit: Situation, region: str, mass: dict[str, float]) -> bool:
     """Whether ``region`` is of a likelier tier for the missing objects than the robot's room (:func:`room_tier`):
     the cabinets of a room unlikely to hold them wait while a likely room or one of unknown type is left to
-    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn). They also
-    wait while a closed door is left to open (the room behind may be likely: outfit_a_basic_toolbox seed 1
-    opened the kitchen's cabinets for tools that lay in the utility room behind its door), and those of a
-    room of the last tier (``ELSEWHERE``) while any room is left to explore."""
+    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn). Those of
+    a room of the last tier (``ELSEWHERE``: unlikely, and across the walls) wait while any room is left to
+    explore or a closed door to open."""
     here = sit.here
     return here is not None and room_tier(belief, region, mass) < room_tier(belief, here, mass)
 
@@ -289,31 +287,50 @@ LIKELY, UNTYPED, UNLIKELY, ACROSS, ELSEWHERE = 0, 1, 2, 3, 4
 """Room tiers for missing objects (:func:`room_tier`), searched in this order."""
 
 
+class RoomMass(dict[str, float]):
+    """Room type -> how many of the missing objects to expect there (:func:`room_mass`), and ``sides``: the sides
+    of the walls (True: outdoors) where some missing object is likeliest, each object (or the items, together)
+    by its own evidence: the car of packing_car_for_trip stands outdoors, its suitcases are kept indoors."""
+
+    def __init__(self, mass: dict[str, float], sides: frozenset[bool]) -> None:
+        super().__init__(mass)
+        self.sides = sides
+
+
+def sides_of(mass: dict[str, float]) -> frozenset[bool]:
+    """The sides of the walls (True: outdoors) holding the most of ``mass``: both on a tie, none when empty."""
+    totals = {side: sum(n for k, n in mass.items() if (k in OUTDOOR_ROOM_TYPES) == side) for side in (False, True)}
+    top = max(totals.values())
+    return frozenset(side for side, n in totals.items() if n == top and n > 0)
+
+
 def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
     """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing objects
     (``mass``, :func:`room_mass`) and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the
     lawn that holds a fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its
     type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
 
-    A room on the other side of the walls from the likeliest type (outdoors when it is indoors, or the other
-    way round; a tie takes neither side) ranks after the unlikely rooms on that type's side: a likely one as
-    ``ACROSS``, an unlikely one as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on
-    the likeliest type's side, and a garden's frontiers lead to more lawn, not to the kitchen of the fridge:
-    bringing_water seed 1 crossed a lawn for 22 steps, likely for bottles and coffee tables, while the living
-    room and the kitchen lay behind doors not yet opened, and once they were open it crossed it again rather
-    than explore the private office the kitchen lay behind."""
+    A room on the other side of the walls from where every missing object is likeliest (outdoors when they all
+    are indoors, or the other way round: ``RoomMass.sides``; for a plain mapping, the side holding the most of
+    it; a tie takes neither side) ranks after the unlikely rooms on their side: a likely one as ``ACROSS``, an
+    unlikely one as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on that side, and
+    a garden's frontiers lead to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed a
+    lawn for 22 steps, likely for bottles and coffee tables, while the living room and the kitchen lay behind
+    doors not yet opened, and once they were open it crossed it again rather than explore the private office
+    the kitchen lay behind. The lawn of a car is on the car's side (packing_car_for_trip seed 2 left it for the
+    house's rooms, where the suitcases and the laptop are usually kept, and found none of them)."""
     kind = belief.room_types.get(region)
     if not mass or kind is None:
         return UNTYPED
     share, top = mass.get(kind, 0.0), max(mass.values())
     likely = share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * top
-    outdoors = kind in OUTDOOR_ROOM_TYPES
-    if max((n for k, n in mass.items() if (k in OUTDOOR_ROOM_TYPES) == outdoors), default=0.0) < top:
+    sides = mass.sides if isinstance(mass, RoomMass) else sides_of(mass)
+    if sides and (kind in OUTDOOR_ROOM_TYPES) not in sides:
         return ACROSS if likely else ELSEWHERE
     return LIKELY if likely else UNLIKELY
 
 
-def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ()) -> dict[str, float]:
+def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ()) -> RoomMass:
     """Room type -> how many of the ``missing`` objects to expect in a room of that type: where the missing
     items are kept (:func:`item_rooms`, one in all) plus, for each missing piece of furniture, the share of
     its kind standing in such rooms (:func:`~more_agent.planners.room_types.furniture_rooms`). Beer, kept as
@@ -326,29 +343,34 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     fridge or a car) are where those were found with the probability that two items of one bddl activity share
     a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
     otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
-    list more trash cans than gardens do."""
+    list more trash cans than gardens do. Where each missing object is likeliest, indoors or out, gives the
+    mass's ``sides`` (:func:`room_tier`)."""
     goal = agenda.goal
     stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
     items = [s for s in missing if s not in stands and s not in stays]
-    parts: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
-    parts += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
-    if items:
-        parts.append((item_rooms(goal, items), any(_set_out(goal, s) for s in items)))
+    objects: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
+    objects += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
+    parts = [*objects, (item_rooms(goal, items), any(_set_out(goal, s) for s in items))] if items else objects
     known = [*found, *(kind for s, kind in stays.items() if _set_out(goal, s))]
     together = {kind: n / len(known) for kind, n in Counter(known).items()}
+
+    def expected(rooms: dict[str, float], with_found: bool) -> dict[str, float]:
+        if not (with_found and together):
+            return rooms
+        share = together_share()
+        return {
+            kind: share * together.get(kind, 0.0) + (1 - share) * rooms.get(kind, 0.0) for kind in {*rooms, *together}
+        }
+
     mass: dict[str, float] = {}
     for rooms, with_found in parts:
-        if with_found and together:
-            share = together_share()
-            rooms = {
-                kind: share * together.get(kind, 0.0) + (1 - share) * rooms.get(kind, 0.0)
-                for kind in {*rooms, *together}
-            }
-        for kind, n in rooms.items():
+        for kind, n in expected(rooms, with_found).items():
             mass[kind] = mass.get(kind, 0.0) + n
-    return mass
+    # the sides: each item by its own evidence (a bag kept on a lawn, the money indoors)
+    by_object = [*objects, *((item_rooms(goal, [s]), _set_out(goal, s)) for s in items)]
+    return RoomMass(mass, frozenset().union(*(sides_of(expected(*part)) for part in by_object)))
 
 
 def _set_out(goal: TaskGoal, scope: str) -> bool:
