@@ -58,7 +58,9 @@ driven to when an item is missing."""
 def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: str | None) -> Choice:
     """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
     containers, closed doors (before a room of a type unlikely to hold the missing items: a car is outside),
-    containers that cannot hold them (:func:`closed_containers`); give up when none is left."""
+    containers that cannot hold them (:func:`closed_containers`); give up when none is left. The containers
+    here wait while a likelier room is left (:func:`likelier_than_here`); those of a room of the last tier
+    (``ELSEWHERE``: unlikely, and across the walls) while any room is left to explore or a door to open."""
     goal = agenda.goal
     missing = [
         s for s in lit.args if s != goal.robot and not goal.is_floor(s) and bind(belief, goal, s, sit.xy) is None
@@ -110,9 +112,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
 def likelier_than_here(belief: Belief, sit: Situation, region: str, mass: dict[str, float]) -> bool:
     """Whether ``region`` is of a likelier tier for the missing objects than the robot's room (:func:`room_tier`):
     the cabinets of a room unlikely to hold them wait while a likely room or one of unknown type is left to
-    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn). Those of
-    a room of the last tier (``ELSEWHERE``: unlikely, and across the walls) wait while any room is left to
-    explore or a closed door to open."""
+    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn)."""
     here = sit.here
     return here is not None and room_tier(belief, region, mass) < room_tier(belief, here, mass)
 
@@ -148,11 +148,13 @@ def closed_containers(
         and o.label not in belief.looked_into
         and o.label not in belief.dropped
     ]
-    kinds: dict[str | None, list[str]] = {}
+    by_region: dict[str | None, list[str]] = {}  # the categories of each room's containers, open or closed
     for o in sit.graph.objects.values():
         if o.open is not None and can_hold_things(o.category):
-            kinds.setdefault(o.region_id, []).append(o.category)
-    like = {o.label: container_likelihood(agenda, o.category, items, kinds.get(o.region_id, ())) for o in candidates}
+            by_region.setdefault(o.region_id, []).append(o.category)
+    like = {
+        o.label: container_likelihood(agenda, o.category, items, by_region.get(o.region_id, ())) for o in candidates
+    }
     likely = sorted(
         (o for o in candidates if like[o.label] > 0),
         key=lambda o: (o.region_id != here, -like[o.label], math.dist(o.position[:2], sit.xy), o.label),
@@ -289,8 +291,8 @@ LIKELY, UNTYPED, UNLIKELY, ACROSS, ELSEWHERE = 0, 1, 2, 3, 4
 
 class RoomMass(dict[str, float]):
     """Room type -> how many of the missing objects to expect there (:func:`room_mass`), and ``sides``: the sides
-    of the walls (True: outdoors) where some missing object is likeliest, each object (or the items, together)
-    by its own evidence: the car of packing_car_for_trip stands outdoors, its suitcases are kept indoors."""
+    of the walls (True: outdoors) where some missing object is likeliest, each by its own evidence: the car of
+    packing_car_for_trip stands outdoors, its laptop and money are kept indoors."""
 
     def __init__(self, mass: dict[str, float], sides: frozenset[bool]) -> None:
         super().__init__(mass)
@@ -339,9 +341,9 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
 
     What is known beats what is usual. An object the description says stays on a room's floor ("leave trash can
     A on the lawn") is in such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`),
-    or the description puts one of them there (the trash can on the lawn), the objects set out with them (items, and furniture that is no scene fixture: the weeds' trash can, not a
-    fridge or a car) are where those were found with the probability that two items of one bddl activity share
-    a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
+    or the description puts one of them there (the trash can on the lawn), the objects set out with them
+    (items, and furniture that is no scene fixture: the weeds' trash can, not a fridge or a car) are where
+    those were found with the probability that two items of one bddl activity share a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
     otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
     list more trash cans than gardens do. Where each missing object is likeliest, indoors or out, gives the
     mass's ``sides`` (:func:`room_tier`)."""
