@@ -33,6 +33,7 @@ from more_agent.planners.grounded.search import (
     OPENS_BEFORE_EXPLORING,
     UNLIKELY,
     UNTYPED,
+    RoomMass,
     closed_containers,
     container_likelihood,
     far_frontiers,
@@ -118,6 +119,12 @@ def with_far_room(sit: Situation) -> tuple[Situation, str]:
     other = RegionNode(id="region_far", centroid=(40.0, 40.0), nav_nodes=[], frontiers=[(40.0, 40.0)])
     graph = sit.graph.model_copy(update={"regions": {**sit.graph.regions, other.id: other}})
     return replace(sit, graph=graph, names={**sit.names, other.id: "garden_0"}), other.id
+
+
+def one_part(mass: dict[str, float]) -> RoomMass:
+    """``mass`` as one missing object's (or several items' together): its sides of the walls are where it holds
+    the most."""
+    return RoomMass(mass, sides_of(mass))
 
 
 def learn(
@@ -573,7 +580,7 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     assert here is not None
     belief.room_types = {here: "kitchen", far: "garden"}
     sack = "sack.n.01_1"
-    kept = item_rooms(agenda.goal, [sack])
+    kept = one_part(item_rooms(agenda.goal, [sack]))
     assert kept["kitchen"] > kept["garden"] > 0  # sacks are kept in kitchens, sometimes on a lawn
     assert room_tier(belief, here, kept) == LIKELY  # the lawn holds under half as many, and lies outdoors:
     assert room_tier(belief, far, kept) == ELSEWHERE  # its frontiers lead to more lawn, not to a kitchen
@@ -655,16 +662,17 @@ def test_a_likely_lawn_waits_for_the_unknown_rooms_when_the_likeliest_type_is_in
     sit, far = with_far_room(sit)
     here = sit.here
     assert here is not None
-    mass = {"living_room": 0.61, "kitchen": 0.44, "garden": 0.39, "bedroom": 0.05}
+    plain = {"living_room": 0.61, "kitchen": 0.44, "garden": 0.39, "bedroom": 0.05}
+    mass = one_part(plain)
     belief.room_types = {here: "kitchen", far: "garden"}
     assert room_tier(belief, here, mass) == LIKELY and room_tier(belief, far, mass) == ACROSS
     belief.room_types[here] = "private_office"  # no bottle, no coffee table: but indoors, where the rest lies
     assert room_tier(belief, here, mass) == UNLIKELY < room_tier(belief, far, mass)
     belief.room_types = {far: "garden"}  # the robot's room not typed yet: unknown before the likely lawn
     assert room_tier(belief, here, mass) == UNTYPED
-    assert room_tier(belief, far, {**mass, "garden": 0.2}) == ELSEWHERE
-    indoors = sum(n for kind, n in mass.items() if kind != "garden")
-    assert room_tier(belief, far, {**mass, "garden": indoors}) == LIKELY  # as likely as the indoors: no side
+    assert room_tier(belief, far, one_part({**plain, "garden": 0.2})) == ELSEWHERE
+    indoors = sum(n for kind, n in plain.items() if kind != "garden")
+    assert room_tier(belief, far, one_part({**plain, "garden": indoors})) == LIKELY  # as likely as the indoors: no side
     # each missing object on its own side: the car stands outdoors, the laptop and the money are kept indoors
     # (packing_car_for_trip seed 2 left the car's lawn for the house and found none of them)
     car, laptop, money = "car.n.01_1", "laptop.n.01_1", "money.n.01_1"
@@ -677,7 +685,7 @@ def test_a_likely_lawn_waits_for_the_unknown_rooms_when_the_likeliest_type_is_in
     )
     packed = room_mass(trip, [laptop, money, car])
     assert packed.sides == {False, True} and sides_of(packed) == {False}  # indoors hold the most
-    assert room_tier(belief, far, packed) == LIKELY and room_tier(belief, far, dict(packed)) == ACROSS
+    assert room_tier(belief, far, packed) == LIKELY and room_tier(belief, far, one_part(packed)) == ACROSS
     bag = "bag.n.06_1"  # each item by its own evidence: bags are kept on lawns more than indoors, money indoors
     bagged = with_goal(
         trip, categories={**trip.goal.categories, bag: frozenset({"bag"})}, moved=frozenset({money, bag})

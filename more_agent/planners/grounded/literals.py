@@ -26,13 +26,13 @@ def holds(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal) -> bool 
     if a is None:
         return None
     if goal.is_floor(target):
+        floor = floor_beneath(belief, a)
+        if goal.stays.get(subject) == target and (floor is not None or unplaced(belief, sit, a)):
+            return not lit.negated  # the description says it lies there: wherever seen, however its region is typed
         want = goal.floor_rooms.get(target)
         if want is not None:  # the floor's room as the planner knows it (a garage typed otherwise, below)
             region = floor_region(belief, sit, agenda, target)
             want = want if region is None else belief.room_types.get(region, "")
-        floor = floor_beneath(belief, a)
-        if goal.stays.get(subject) == target and (floor is not None or unplaced(belief, sit, a)):
-            return not lit.negated  # the description says it lies there: wherever seen, however its region is typed
         on = floor is not None and (want is None or floor[1] == f"{FLOOR} {want}")
         return on != lit.negated
     b = bind(belief, goal, target, sit.xy)

@@ -59,7 +59,8 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
     containers, closed doors (before a room of a type unlikely to hold the missing items: a car is outside),
     containers that cannot hold them (:func:`closed_containers`); give up when none is left. The containers
-    here wait while a likelier room is left (:func:`likelier_than_here`); those of a room of the last tier
+    here wait while a room of a likelier tier (:func:`room_tier`) is left to explore (cleaning_parks seed 1
+    opened 18 kitchen cabinets for the bottles that lay on the lawn); those of a room of the last tier
     (``ELSEWHERE``: unlikely, and across the walls) while any room is left to explore or a door to open."""
     goal = agenda.goal
     missing = [
@@ -78,8 +79,9 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     region = room_to_explore(belief, sit, agenda, missing, rooms, mass)
     doors = closed_doors(belief, sit)
     here_tier = room_tier(belief, sit.here, mass) if sit.here is not None else UNTYPED
+    region_tier = room_tier(belief, region, mass) if region is not None else UNTYPED
     left = region is not None and not stale(belief, region)
-    likelier = region is not None and left and likelier_than_here(belief, sit, region, mass)
+    likelier = left and sit.here is not None and region_tier < here_tier
     if (
         closed
         and closed[0].region_id == sit.here
@@ -88,14 +90,14 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         and not (here_tier == ELSEWHERE and (left or doors))
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
-    if searching_items and (region is None or stale(belief, region) or region not in rooms):
+    if searching_items and (not left or region not in rooms):
         furniture = furniture_to_look_at(belief, sit, rooms)
         if furniture is not None:
             return object_step(sit, "navigate", furniture, note)
         in_task_rooms = [o for o in closed if o.region_id in rooms]
         if in_task_rooms:
             return open_to_look(belief, sit, agenda, in_task_rooms[0].label, held, note)
-    unlikely = region is not None and room_tier(belief, region, mass) >= UNLIKELY
+    unlikely = region is not None and region_tier >= UNLIKELY
     if region is not None and left and not (unlikely and doors):
         return explore_step(sit, region, note)
     for pool in (doors, closed) if unlikely or here_tier == ELSEWHERE else (closed, doors):  # the way out first
@@ -107,14 +109,6 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
         return open_to_look(belief, sit, agenda, unlikely_containers[0].label, held, note)
     why = f"{note}: nothing left to explore or open"
     return Choice(Step(DONE, note=why, gave_up=f"grounded planner gave up {why}"))
-
-
-def likelier_than_here(belief: Belief, sit: Situation, region: str, mass: dict[str, float]) -> bool:
-    """Whether ``region`` is of a likelier tier for the missing objects than the robot's room (:func:`room_tier`):
-    the cabinets of a room unlikely to hold them wait while a likely room or one of unknown type is left to
-    explore (cleaning_parks seed 1 opened 18 kitchen cabinets for the bottles that lay on the lawn)."""
-    here = sit.here
-    return here is not None and room_tier(belief, region, mass) < room_tier(belief, here, mass)
 
 
 def other_missing_items(belief: Belief, agenda: Agenda, items: Sequence[str]) -> list[str]:
@@ -249,7 +243,7 @@ def room_to_explore(
     agenda: Agenda,
     missing: list[str],
     rooms: set[str],
-    mass: dict[str, float] | None = None,
+    mass: RoomMass | None = None,
 ) -> str | None:
     """The region with unexplored areas to explore next: rooms whose last explores revealed nothing
     new last; then by :func:`room_tier` for the missing objects (:func:`room_mass`: a room type where such
@@ -306,15 +300,14 @@ def sides_of(mass: dict[str, float]) -> frozenset[bool]:
     return frozenset(side for side, n in totals.items() if n == top and n > 0)
 
 
-def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
+def room_tier(belief: Belief, region: str, mass: RoomMass) -> int:
     """``LIKELY`` when the region's room type holds at least ``LIKELY_ROOM_SHARE`` of the missing objects
     (``mass``, :func:`room_mass`) and ``LIKELY_OF_TOP`` of the likeliest type's (bottles: kitchens, not the
     lawn that holds a fifth as many), ``UNLIKELY`` when its type is known and does not, ``UNTYPED`` when its
     type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
 
     A room on the other side of the walls from where every missing object is likeliest (outdoors when they all
-    are indoors, or the other way round: ``RoomMass.sides``; for a plain mapping, the side holding the most of
-    it; a tie takes neither side) ranks after the unlikely rooms on their side: a likely one as ``ACROSS``, an
+    are indoors, or the other way round: ``RoomMass.sides``; a tie takes neither side) ranks after the unlikely rooms on their side: a likely one as ``ACROSS``, an
     unlikely one as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on that side, and
     a garden's frontiers lead to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed a
     lawn for 22 steps, likely for bottles and coffee tables, while the living room and the kitchen lay behind
@@ -326,8 +319,7 @@ def room_tier(belief: Belief, region: str, mass: dict[str, float]) -> int:
         return UNTYPED
     share, top = mass.get(kind, 0.0), max(mass.values())
     likely = share >= LIKELY_ROOM_SHARE and share >= LIKELY_OF_TOP * top
-    sides = mass.sides if isinstance(mass, RoomMass) else sides_of(mass)
-    if sides and (kind in OUTDOOR_ROOM_TYPES) not in sides:
+    if mass.sides and (kind in OUTDOOR_ROOM_TYPES) not in mass.sides:
         return ACROSS if likely else ELSEWHERE
     return LIKELY if likely else UNLIKELY
 
@@ -354,7 +346,9 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     items = [s for s in missing if s not in stands and s not in stays]
     objects: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
     objects += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
-    parts = [*objects, (item_rooms(goal, items), any(_set_out(goal, s) for s in items))] if items else objects
+    each_item = [(item_rooms(goal, [s]), _set_out(goal, s)) for s in items]
+    items_together = (mean_rooms([rooms for rooms, _ in each_item]), any(out for _, out in each_item))
+    parts = [*objects, items_together] if items else objects
     known = [*found, *(kind for s, kind in stays.items() if _set_out(goal, s))]
     together = {kind: n / len(known) for kind, n in Counter(known).items()}
 
@@ -371,8 +365,7 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
         for kind, n in expected(rooms, with_found).items():
             mass[kind] = mass.get(kind, 0.0) + n
     # the sides: each item by its own evidence (a bag kept on a lawn, the money indoors)
-    by_object = [*objects, *((item_rooms(goal, [s]), _set_out(goal, s)) for s in items)]
-    return RoomMass(mass, frozenset().union(*(sides_of(expected(*part)) for part in by_object)))
+    return RoomMass(mass, frozenset().union(*(sides_of(expected(*part)) for part in [*objects, *each_item])))
 
 
 def _set_out(goal: TaskGoal, scope: str) -> bool:
@@ -385,9 +378,14 @@ def item_rooms(goal: TaskGoal, items: Sequence[str]) -> dict[str, float]:
     """Room type -> where the missing ``items`` (scopes) are kept: the mean of their room priors
     (:func:`~more_agent.planners.whereabouts.room_prior`, the goal's own activity left out) over the items
     that have evidence; {} when none has."""
-    priors = [p for p in (room_prior(scope_synset(s), goal.activity) for s in items) if p]
-    kinds = {kind for p in priors for kind in p}
-    return {kind: sum(p.get(kind, 0.0) for p in priors) / len(priors) for kind in kinds}
+    return mean_rooms([room_prior(scope_synset(s), goal.activity) for s in items])
+
+
+def mean_rooms(priors: Sequence[dict[str, float]]) -> dict[str, float]:
+    """Room type -> the mean of the room ``priors`` that have evidence; {} when none has."""
+    known = [p for p in priors if p]
+    kinds = {kind for p in known for kind in p}
+    return {kind: sum(p.get(kind, 0.0) for p in known) / len(known) for kind in kinds}
 
 
 def unseen_floor(sit: Situation, regions: Sequence[str]) -> dict[str, float]:
