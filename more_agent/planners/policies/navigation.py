@@ -110,14 +110,48 @@ def _cells(occupancy: OccupancyMap, points: Sequence[XY] | np.ndarray) -> np.nda
     return cells[((cells >= 0) & (cells < occupancy.grid.shape)).all(axis=1)]
 
 
-def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float) -> list[XY | None]:
-    """Each goal moved to its nearest traversable cell centre, or None when that is farther than ``max_m``."""
+def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float, sight: np.ndarray | None = None) -> list[XY | None]:
+    """Each goal moved to its nearest traversable cell centre, or None when that is farther than ``max_m``.
+    With ``sight`` (a boolean raster of the cells a line of sight crosses, on ``grid``), to the nearest
+    traversable cell from which the straight line to the goal crosses only such cells or traversable ones."""
     out: list[XY | None] = []
     for g in goals:
+        if sight is not None:
+            out.append(nearest_in_sight(grid, sight | grid.free, g, max_m))
+            continue
         cell = grid.snap(*g)
         xy = grid.centre(cell) if cell is not None else None
         out.append(xy if xy is not None and math.dist(xy, g) <= max_m else None)
     return out
+
+
+SIGHT_CHUNK = 4096
+"""Candidate cells whose lines of sight are tested at once (nearest first) by :func:`nearest_in_sight`."""
+
+
+def nearest_in_sight(grid: NavGrid, clear: np.ndarray, goal: XY, max_m: float) -> XY | None:
+    """The centre of the traversable cell nearest to ``goal`` within ``max_m`` from which the straight line
+    to it crosses only ``clear`` cells, None when there is none: a frontier seen through a doorway lies a
+    hand's breadth beyond a wall that the camera never saw, and the cell nearest to it, on this side of that
+    wall, shows nothing of what lies beyond."""
+    reach = int(math.ceil(max_m / grid.resolution_m))
+    gx, gy = (int(v) for v in grid.cell_of(goal))
+    x0, y0 = max(gx - reach, 0), max(gy - reach, 0)
+    cells = np.argwhere(grid.free[x0 : gx + reach + 1, y0 : gy + reach + 1]) + (x0, y0)
+    centres = np.asarray(grid.xy_of(cells), dtype=float).reshape(-1, 2)
+    distance = np.hypot(centres[:, 0] - goal[0], centres[:, 1] - goal[1])
+    order = np.argsort(distance, kind="stable")
+    order = order[distance[order] <= max_m]
+    samples = np.linspace(0.0, 1.0, 2 * reach + 2)[None, :, None]
+    for start in range(0, len(order), SIGHT_CHUNK):
+        chunk = order[start : start + SIGHT_CHUNK]
+        line = centres[chunk, None, :] + samples * (np.asarray(goal, dtype=float) - centres[chunk, None, :])
+        along = np.clip(grid.cell_of(line), 0, np.asarray(clear.shape) - 1)  # off the grid reads as its rim
+        hits = np.flatnonzero(clear[along[..., 0], along[..., 1]].all(axis=1))
+        if len(hits):
+            x, y = centres[chunk[hits[0]]]
+            return float(x), float(y)
+    return None
 
 
 def reachable_part(grid: NavGrid, start: XY) -> NavGrid:
@@ -130,11 +164,14 @@ def reachable_part(grid: NavGrid, start: XY) -> NavGrid:
     return replace(grid, free=components == components[cell])
 
 
-def path_to_nearest(grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: float) -> tuple[PathResult, int | None]:
+def path_to_nearest(
+    grid: NavGrid, start: XY, goals: Sequence[XY], *, snap_m: float, sight: np.ndarray | None = None
+) -> tuple[PathResult, int | None]:
     """Shortest path from ``start`` to the nearest reachable goal (goals snapped first, to the robot's
-    free component) and that goal's index."""
+    free component; in sight of them through ``sight``'s cells when given, :func:`snap_goals`) and that
+    goal's index."""
     grid = reachable_part(grid, start)
-    snapped = snap_goals(grid, goals, snap_m)
+    snapped = snap_goals(grid, goals, snap_m, sight)
     usable = [i for i, g in enumerate(snapped) if g is not None]
     if not usable:
         return shortest_path(grid, start, []), None

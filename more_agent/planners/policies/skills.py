@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator, Sequence
 import numpy as np
 from scipy import ndimage
 
+from more_agent.mapping import FREE
 from more_agent.planners.policies.embodiment import Embodiment
 from more_agent.planners.policies.navigation import agent_nav_grid, object_goal, path_to_nearest
 from more_agent.planners.targets import Area, Target, Unresolved
@@ -36,20 +37,21 @@ def _fail(reason: FailureReason, feedback: str, steps: int = 0) -> ActionResult:
 
 
 def _drive(
-    body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None
+    body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None, *, in_sight: bool = False
 ) -> tuple[bool, int | None, str]:
     """Drive to the nearest reachable goal on the agent's map (goals off it snapped within ``snap_m``,
-    default ``goal_snap_m``), replanning on the updated map when a move is blocked. Returns (reached,
-    goal index, failure feedback)."""
+    default ``goal_snap_m``; with ``in_sight``, only to a spot from which the line to the goal crosses cells
+    seen free), replanning on the updated map when a move is blocked. Returns (reached, goal index, failure
+    feedback)."""
     cfg = body.config
     snap_m = cfg.goal_snap_m if snap_m is None else snap_m
     occupancy, retraced = graph.occupancy, False
     for _ in range(cfg.max_replans + 1):
         if occupancy is None:
             return False, None, "no map yet"
-        path, index = plan_path(body, occupancy, goals, snap_m)
+        path, index = plan_path(body, occupancy, goals, snap_m, in_sight=in_sight)
         if index is None:  # once per drive: a way back walked again would lead into the nook again
-            way = None if retraced else way_back(body, occupancy, goals, snap_m)
+            way = None if retraced else way_back(body, occupancy, goals, snap_m, in_sight=in_sight)
             if way is None:
                 return False, None, "no path on the map"
             retraced = True
@@ -87,13 +89,16 @@ RETRACE_M = 12.0
 """How far back along its own way the robot retraces, at most, to a place from which its map leads on."""
 
 
-def way_back(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float) -> list[XY] | None:
+def way_back(
+    body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float, *, in_sight: bool = False
+) -> list[XY] | None:
     """When no path on the agent's map leads to any goal: the robot's own way in, walked backwards through
     the exact positions it held, to the last one (within ``RETRACE_M``) from which a path does lead on.
     The base drove those positions, and the world's base meets only furniture and walls: a final approach
     may have driven it over items on the floor, which its map then shows as obstacles across the way it
     came by (putting_out_condiments seed 2: seven such cells sealed a kitchen). The map keeps them; only
-    the exact way driven is trusted through them. None when no position within reach of it leads on."""
+    the exact way driven is trusted through them. None when no position within reach of it leads on.
+    ``in_sight`` as in :func:`_drive`."""
     grid = _nav_grid(body, occupancy, retrace=True)
     parts, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
     here = grid.snap(*body.xy)
@@ -103,7 +108,7 @@ def way_back(body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], sna
         if part in tried:
             continue
         tried.add(part)
-        if path_to_nearest(grid, way[-1], goals, snap_m=snap_m)[1] is not None:
+        if path_to_nearest(grid, way[-1], goals, snap_m=snap_m, sight=_sight(occupancy, in_sight))[1] is not None:
             return way
     return None
 
@@ -123,22 +128,28 @@ def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
 
 
 def plan_path(
-    body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float
+    body: Embodiment, occupancy: OccupancyMap, goals: Sequence[XY], snap_m: float, *, in_sight: bool = False
 ) -> tuple[PathResult, int | None]:
     """Shortest path on the agent's map to the nearest reachable goal; when none is, the same with the
     robot retracing its own path (``agent_nav_grid``'s ``retrace``), then with the clearance of the base
     itself (``ROBOT.radius_m``, the world's rule) rather than the planning margin on top: paths keep the
     full clearance wherever they can, the robot is never sealed in where a final approach left it, and a
     gap the base fits through on the map is not closed by the margin (a gap 0.4-0.5 m wide on the map
-    hid the hall of packing_fishing_gear_into_car seed 0)."""
+    hid the hall of packing_fishing_gear_into_car seed 0). ``in_sight`` as in :func:`_drive`."""
     full = body.config.plan_inflation_m
+    sight = _sight(occupancy, in_sight)
     tight = min(full, ROBOT.radius_m)
     for inflation, retrace in ((full, False), (full, True), (tight, True)):
         grid = _nav_grid(body, occupancy, inflation_m=inflation, retrace=retrace)
-        path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m)
+        path, index = path_to_nearest(grid, body.xy, goals, snap_m=snap_m, sight=sight)
         if index is not None:
             break
     return path, index
+
+
+def _sight(occupancy: OccupancyMap, in_sight: bool) -> np.ndarray | None:
+    """The cells a line of sight crosses on the agent's map (those seen free) when ``in_sight``, else None."""
+    return np.asarray(occupancy.grid) == FREE if in_sight else None
 
 
 def _nav_grid(
@@ -172,9 +183,9 @@ def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[
     frontiers = [f for f in candidates if all(math.dist(f, v) > near for v in body.visited_frontiers)]
     if not frontiers:
         return _fail(FailureReason.INVALID_TARGET, f"no frontier left in {room}")
-    reached, index, why = _drive(body, graph, frontiers)
+    reached, index, why = _drive(body, graph, frontiers, in_sight=True)
     if index is None:
-        reached, index, why = _drive(body, graph, frontiers, snap_m=body.builder.config.max_range_m)
+        reached, index, why = _drive(body, graph, frontiers, snap_m=body.builder.config.max_range_m, in_sight=True)
     if index is not None:
         body.visited_frontiers.append(frontiers[index])
     if not reached:
