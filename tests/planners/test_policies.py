@@ -154,24 +154,23 @@ def _with_strip(graph: SceneGraph, length_m: float) -> tuple[SceneGraph, tuple[f
     return graph.model_copy(update={"occupancy": strip}), (float(x), float(y))
 
 
-def test_explore_looks_from_where_the_frontier_is_in_sight() -> None:
-    """The spot explore drives to sees its frontier: the straight line between them crosses floor seen free,
-    never the wall the camera has not mapped yet (bringing_newspaper_in seed 3 stood half a metre from a
-    frontier seen through a door, on this side of the wall, and counted it explored)."""
-    _, body, graph = fresh()
-    graph, beyond = _with_strip(graph, 0.6)
-    occupancy = graph.occupancy
-    assert occupancy is not None
-    walled = np.array(occupancy.grid)
-    ix, iy = occupancy.frame.cell_of(beyond)
-    walled[ix - 4, :] = np.where(walled[ix - 4, :] == FREE, 0, walled[ix - 4, :])  # an unseen wall across the strip
-    walled[ix - 4, iy] = FREE  # ... but for the strip itself, the door
-    walled_graph = graph.model_copy(update={"occupancy": occupancy.model_copy(update={"grid": walled})})
-    result = explore_frontiers(body, walled_graph, [beyond], "kitchen_0")
-    assert result.ok, result.feedback
-    xy = np.asarray(body.xy)
-    along = occupancy.frame.cell_of(xy + np.linspace(0.0, 1.0, 50)[:, None] * (np.asarray(beyond) - xy))
-    assert (walled[along[:, 0], along[:, 1]] == FREE).all() or math.dist(body.xy, beyond) < 0.1
+def test_goals_snap_to_a_spot_in_sight_of_them() -> None:
+    """explore()'s frontiers snap to a spot that sees them: the straight line between them crosses floor seen
+    free, not the wall the camera has not mapped yet (bringing_newspaper_in seed 3 stood half a metre from a
+    frontier seen through a door, on this side of the wall, looked around, and counted it explored)."""
+    grid = np.full((40, 30), FREE)  # [ix, iy], 0.1 m cells
+    grid[20, :] = 0  # a wall the camera has not seen, at x = 2.0-2.1 m ...
+    grid[20, 6:9] = FREE  # ... but for a door, the floor beyond seen through it ...
+    grid[20, [5, 9]] = OCCUPIED  # ... between jambs narrower than the base's clearance
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    nav = agent_nav_grid(occupancy, inflation_m=0.25)
+    start, goal = (0.55, 0.55), (2.45, 1.25)
+    near = path_to_nearest(nav, start, [goal], snap_m=1.5)[0].waypoints[-1]
+    assert near[0] < 2.0 and abs(near[1] - goal[1]) < 0.1  # straight across the wall
+    seeing = path_to_nearest(nav, start, [goal], snap_m=1.5, sight=grid == FREE)[0].waypoints[-1]
+    line = occupancy.frame.cell_of(np.linspace(seeing, goal, 40))
+    assert (grid[line[:, 0], line[:, 1]] == FREE).all() and math.dist(seeing, goal) <= 1.5
+    assert path_to_nearest(nav, start, [goal], snap_m=0.8, sight=grid == FREE)[0].waypoints[-1] == near  # none so near
 
 
 def test_pick_target_prefers_what_the_skill_can_act_on(

@@ -113,11 +113,14 @@ def _cells(occupancy: OccupancyMap, points: Sequence[XY] | np.ndarray) -> np.nda
 def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float, sight: np.ndarray | None = None) -> list[XY | None]:
     """Each goal moved to its nearest traversable cell centre, or None when that is farther than ``max_m``.
     With ``sight`` (a boolean raster of the cells a line of sight crosses, on ``grid``), to the nearest
-    traversable cell from which the straight line to the goal crosses only such cells or traversable ones."""
+    traversable cell within ``max_m`` from which the straight line to the goal crosses only such cells or
+    traversable ones, where there is one."""
+    clear = None if sight is None else sight | grid.free
     out: list[XY | None] = []
     for g in goals:
-        if sight is not None:
-            out.append(nearest_in_sight(grid, sight | grid.free, g, max_m))
+        seeing = None if clear is None else nearest_in_sight(grid, clear, g, max_m)
+        if seeing is not None:
+            out.append(seeing)
             continue
         cell = grid.snap(*g)
         xy = grid.centre(cell) if cell is not None else None
