@@ -128,33 +128,28 @@ def snap_goals(grid: NavGrid, goals: Sequence[XY], max_m: float, sight: np.ndarr
     return out
 
 
-SIGHT_CHUNK = 4096
-"""Candidate cells whose lines of sight are tested at once (nearest first) by :func:`nearest_in_sight`."""
-
-
 def nearest_in_sight(grid: NavGrid, clear: np.ndarray, goal: XY, max_m: float) -> XY | None:
     """The centre of the traversable cell nearest to ``goal`` within ``max_m`` from which the straight line
     to it crosses only ``clear`` cells, None when there is none: a frontier seen through a doorway lies a
     hand's breadth beyond a wall that the camera never saw, and the cell nearest to it, on this side of that
-    wall, shows nothing of what lies beyond."""
-    reach = int(math.ceil(max_m / grid.resolution_m))
-    gx, gy = (int(v) for v in grid.cell_of(goal))
-    x0, y0 = max(gx - reach, 0), max(gy - reach, 0)
-    cells = np.argwhere(grid.free[x0 : gx + reach + 1, y0 : gy + reach + 1]) + (x0, y0)
-    centres = np.asarray(grid.xy_of(cells), dtype=float).reshape(-1, 2)
+    wall, shows nothing of what lies beyond. Rays cast from the goal in half-cell steps, as many as cells on
+    the circle of ``max_m``, each ending at its first cell that is not clear (or off the grid)."""
+    res = grid.resolution_m
+    radii = np.arange(int(math.ceil(2 * max_m / res)) + 1) * (res / 2)
+    angles = np.linspace(0.0, 2 * np.pi, max(8, int(math.ceil(2 * np.pi * max_m / res))), endpoint=False)
+    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    points = np.asarray(goal, dtype=float) + radii[None, :, None] * directions[:, None, :]
+    cells = grid.cell_of(points)  # (rays, radii, 2)
+    inside = ((cells >= 0) & (cells < grid.shape)).all(axis=2)
+    ix, iy = (np.clip(cells[..., a], 0, grid.shape[a] - 1) for a in (0, 1))
+    seen = np.cumprod(inside & clear[ix, iy], axis=1).astype(bool)  # clear all the way from the goal
+    ray, step = np.nonzero(seen & grid.free[ix, iy])
+    centres = grid.xy_of(np.stack([ix[ray, step], iy[ray, step]], axis=1)).reshape(-1, 2)
     distance = np.hypot(centres[:, 0] - goal[0], centres[:, 1] - goal[1])
-    order = np.argsort(distance, kind="stable")
-    order = order[distance[order] <= max_m]
-    samples = np.linspace(0.0, 1.0, 2 * reach + 2)[None, :, None]
-    for start in range(0, len(order), SIGHT_CHUNK):
-        chunk = order[start : start + SIGHT_CHUNK]
-        line = centres[chunk, None, :] + samples * (np.asarray(goal, dtype=float) - centres[chunk, None, :])
-        along = np.clip(grid.cell_of(line), 0, np.asarray(clear.shape) - 1)  # off the grid reads as its rim
-        hits = np.flatnonzero(clear[along[..., 0], along[..., 1]].all(axis=1))
-        if len(hits):
-            x, y = centres[chunk[hits[0]]]
-            return float(x), float(y)
-    return None
+    if not len(distance) or distance.min() > max_m:
+        return None
+    x, y = centres[int(np.argmin(distance))]
+    return float(x), float(y)
 
 
 def reachable_part(grid: NavGrid, start: XY) -> NavGrid:

@@ -40,9 +40,9 @@ def _drive(
     body: Embodiment, graph: SceneGraph, goals: Sequence[XY], snap_m: float | None = None, *, in_sight: bool = False
 ) -> tuple[bool, int | None, str]:
     """Drive to the nearest reachable goal on the agent's map (goals off it snapped within ``snap_m``,
-    default ``goal_snap_m``; with ``in_sight``, only to a spot from which the line to the goal crosses cells
-    seen free), replanning on the updated map when a move is blocked. Returns (reached, goal index, failure
-    feedback)."""
+    default ``goal_snap_m``; with ``in_sight``, to a spot from which the straight line to the goal crosses
+    only floor seen free where one lies that near, :func:`~.navigation.snap_goals`), replanning on the
+    updated map when a move is blocked. Returns (reached, goal index, failure feedback)."""
     cfg = body.config
     snap_m = cfg.goal_snap_m if snap_m is None else snap_m
     occupancy, retraced = graph.occupancy, False
@@ -177,7 +177,9 @@ def explore_frontiers(body: Embodiment, graph: SceneGraph, candidates: Sequence[
     """Go to the closest of ``candidates`` (frontiers) not explored before, and look around there;
     ``room`` names the area in the feedback. When no path leads to any of them (unknown space seen only
     as a strip through a doorway narrower than the robot's clearance on its map), go to the reachable spot
-    nearest one within sensor range and look from there: what lies beyond is in view from it."""
+    nearest one within sensor range and look from there. Either way the spot is one that sees the frontier
+    where there is one (:func:`~.navigation.nearest_in_sight`), not the nearest spot behind a wall the camera
+    has not mapped: what the look around shows is then what lies beyond."""
     start = body.low_level_steps
     near = body.config.visited_frontier_m
     frontiers = [f for f in candidates if all(math.dist(f, v) > near for v in body.visited_frontiers)]
