@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from more_agent.mapping import FREE, OCCUPIED
+from more_agent.mapping import FREE, OCCUPIED, UNKNOWN
 from more_agent.planners.policies import (
     Embodiment,
     agent_nav_grid,
@@ -159,7 +159,7 @@ def test_goals_snap_to_a_spot_in_sight_of_them() -> None:
     free, not the wall the camera has not mapped yet (bringing_newspaper_in seed 3 stood half a metre from a
     frontier seen through a door, on this side of the wall, looked around, and counted it explored)."""
     grid = np.full((40, 30), FREE)  # [ix, iy], 0.1 m cells
-    grid[20, :] = 0  # a wall the camera has not seen, at x = 2.0-2.1 m ...
+    grid[20, :] = UNKNOWN  # a wall the camera has not seen, at x = 2.0-2.1 m ...
     grid[20, 6:9] = FREE  # ... but for a door, the floor beyond seen through it ...
     grid[20, [5, 9]] = OCCUPIED  # ... between jambs narrower than the base's clearance
     occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
