@@ -307,9 +307,10 @@ def room_tier(belief: Belief, region: str, mass: RoomMass) -> int:
     type is unknown or nothing missing has evidence (``mass`` empty: every room as likely).
 
     A room on the other side of the walls from where every missing object is likeliest (outdoors when they all
-    are indoors, or the other way round: ``RoomMass.sides``; a tie takes neither side) ranks after the unlikely rooms on their side: a likely one as ``ACROSS``, an
-    unlikely one as ``ELSEWHERE``, last. The rooms still unseen that may hold the objects lie on that side, and
-    a garden's frontiers lead to more lawn, not to the kitchen of the fridge: bringing_water seed 1 crossed a
+    are indoors, or the other way round: ``RoomMass.sides``; a tie takes neither side) ranks after the unlikely
+    rooms on their side: a likely one as ``ACROSS``, an unlikely one as ``ELSEWHERE``, last. The rooms still
+    unseen that may hold the objects lie on that side, and a garden's frontiers lead to more lawn, not to the
+    kitchen of the fridge: bringing_water seed 1 crossed a
     lawn for 22 steps, likely for bottles and coffee tables, while the living room and the kitchen lay behind
     doors not yet opened, and once they were open it crossed it again rather than explore the private office
     the kitchen lay behind. The lawn of a car is on the car's side (packing_car_for_trip seed 2 left it for the
@@ -335,9 +336,10 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     A on the lawn") is in such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`),
     or the description puts one of them there (the trash can on the lawn), the objects set out with them
     (items, and furniture that is no scene fixture: the weeds' trash can, not a fridge or a car) are where
-    those were found with the probability that two items of one bddl activity share a room type (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept
-    otherwise: one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms
-    list more trash cans than gardens do. Where each missing object is likeliest, indoors or out, gives the
+    those were found with the probability that two items of one bddl activity share a room type
+    (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept otherwise:
+    one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms list more
+    trash cans than gardens do. Where each missing object is likeliest, indoors or out, gives the
     mass's ``sides`` (:func:`room_tier`)."""
     goal = agenda.goal
     stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}

@@ -144,7 +144,7 @@ def nearest_in_sight(grid: NavGrid, clear: np.ndarray, goal: XY, max_m: float) -
     ix, iy = (np.clip(cells[..., a], 0, grid.shape[a] - 1) for a in (0, 1))
     seen = np.cumprod(inside & clear[ix, iy], axis=1).astype(bool)  # clear all the way from the goal
     ray, step = np.nonzero(seen & grid.free[ix, iy])
-    centres = grid.xy_of(np.stack([ix[ray, step], iy[ray, step]], axis=1)).reshape(-1, 2)
+    centres = grid.xy_of(np.stack([ix[ray, step], iy[ray, step]], axis=1))
     distance = np.hypot(centres[:, 0] - goal[0], centres[:, 1] - goal[1])
     if not len(distance) or distance.min() > max_m:
         return None

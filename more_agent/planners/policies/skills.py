@@ -100,6 +100,7 @@ def way_back(
     the exact way driven is trusted through them. None when no position within reach of it leads on.
     ``in_sight`` as in :func:`_drive`."""
     grid = _nav_grid(body, occupancy, retrace=True)
+    sight = _sight(occupancy, in_sight)
     parts, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
     here = grid.snap(*body.xy)
     tried = {parts[here] if here is not None else 0, 0}
@@ -108,7 +109,7 @@ def way_back(
         if part in tried:
             continue
         tried.add(part)
-        if path_to_nearest(grid, way[-1], goals, snap_m=snap_m, sight=_sight(occupancy, in_sight))[1] is not None:
+        if path_to_nearest(grid, way[-1], goals, snap_m=snap_m, sight=sight)[1] is not None:
             return way
     return None
 
