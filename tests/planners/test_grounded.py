@@ -29,7 +29,9 @@ from more_agent.planners.grounded.search import (
     ACROSS,
     ELSEWHERE,
     FRUITLESS_EXPLORES,
+    GAIN_STEP_M2,
     LIKELY,
+    LIKELY_ROOM_SHARE,
     OPENS_BEFORE_EXPLORING,
     UNLIKELY,
     UNTYPED,
@@ -650,6 +652,15 @@ def test_where_the_task_s_objects_are_known_to_be_outweighs_where_such_things_ar
     assert room_tier(belief, far, room_mass(weeds, [can], ["garden"])) == LIKELY
     assert room_mass(weeds, [can]).get("garden", 0.0) == 0.0  # bathrooms list trash cans; gardens none
     assert room_mass(weeds, [fridge], ["garden"]) == room_mass(weeds, [fridge])  # a fixture stands where it stands
+    # before anything is found, the trash can set out with the weeds is where weeds are: on the lawn (hoe_weeds
+    # seed 2 searched the bathrooms the trash can's kind stands in, and their cabinets, for 20 steps)
+    weed = "weed.n.01_1"
+    weeds = with_goal(weeds, categories={**weeds.goal.categories, weed: frozenset({"weed"})}, activity="hoe_weeds")
+    both = room_mass(weeds, [weed, can])
+    assert both.sides == {True} and both["garden"] > 1.9
+    belief.room_types = {here: "bathroom", far: "garden"}
+    assert room_tier(belief, here, both) == ELSEWHERE and room_tier(belief, far, both) == LIKELY
+    assert room_mass(weeds, [weed, fridge]).sides == {False, True}  # a fixture does not follow the items
 
 
 def test_a_likely_lawn_waits_for_the_unknown_rooms_when_the_likeliest_type_is_indoors() -> None:
@@ -730,6 +741,32 @@ def test_the_last_tier_s_containers_wait_for_any_room_and_the_closed_doors() -> 
     assert search(belief, shut, agenda, unseen, None).action.arguments[-1] == "door A"
     belief.room_types = {here: "bathroom"}  # unlikely, indoors: its containers before the doors
     assert search(belief, shut, agenda, unseen, None).action.arguments[-1] == "fridge A"
+
+
+def test_rooms_of_the_last_tier_rank_by_the_floor_they_hide_not_by_what_little_they_may_hold() -> None:
+    """cleaning_up_branches_and_twigs seed 1: the branches and their trash can are on the lawn, so every room of
+    the house is of the last tier; the 2 % that the corpus leaves to kitchens kept the robot exploring the
+    kitchen for 7 steps. Across the walls and unlikely, rooms rank by the unseen floor their frontiers show."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    sit, far = with_far_room(sit)
+    here = sit.here
+    assert here is not None
+    branch, can, lawn = "branch.n.02_1", "ashcan.n.01_1", "lawn.n.01_1"
+    cats = {**agenda.goal.categories, branch: frozenset({"branch"}), can: frozenset({"trash_can"})}
+    told = with_goal(
+        agenda,
+        categories=cats,
+        activity="cleaning_up_branches_and_twigs",
+        moved=frozenset({branch, can}),
+        floor_rooms={lawn: "garden"},
+        stays={can: lawn},
+    )
+    mass = room_mass(told, [branch, can])
+    belief.room_types = {here: "kitchen", far: "bedroom"}
+    assert 0 < mass["kitchen"] < LIKELY_ROOM_SHARE and "bedroom" not in mass
+    assert room_tier(belief, here, mass) == room_tier(belief, far, mass) == ELSEWHERE
+    assert unseen_floor(sit, [here, far])[far] > unseen_floor(sit, [here, far])[here] + GAIN_STEP_M2
+    assert room_to_explore(belief, sit, told, [branch, can], set()) == far
 
 
 def test_a_container_is_judged_by_every_item_of_the_goal_not_seen_yet() -> None:

@@ -250,8 +250,10 @@ def room_to_explore(
     items are kept or such furniture stands: a utility room before a lawn for tools; then rooms of a type
     not yet known; rooms of an unlikely type last); then by that mass (weeds are looked for on the lawn,
     not in the bathrooms that list the trash can they go in; beer and its fridge in a kitchen, not in
-    the garden where beer is as often kept); then the room most likely to hold the missing furniture
-    (by the share of the room type's listed objects it makes up,
+    the garden where beer is as often kept; not for a room of the last tier, ``ELSEWHERE``, whose share is
+    below the mark anyway: cleaning_up_branches_and_twigs seed 1 explored a kitchen for 7 steps for the 2 %
+    of branches the corpus leaves there while the lawn lay outside); then the room most likely to hold the
+    missing furniture (by the share of the room type's listed objects it makes up,
     :func:`~more_agent.planners.room_types.listed_share`); then the rooms of the task's items found so far
     (``rooms``, from :func:`task_rooms`); then the room whose frontiers show the most unseen floor in
     sensor range (``GAIN_STEP_M2`` steps: a garden or a store is searched through, not left for a closet
@@ -264,11 +266,13 @@ def room_to_explore(
 
     def score(rid: str) -> tuple[bool, int, float, float, bool, int, float, str]:
         kind = belief.room_types.get(rid)
-        like = max((listed_share(c, kind) for c in cats), default=0.0) if kind else 0.0
+        tier = room_tier(belief, rid, mass)
+        weighed = kind is not None and tier != ELSEWHERE
+        like = max((listed_share(c, kind) for c in cats), default=0.0) if weighed else 0.0
         return (
             stale(belief, rid),
-            room_tier(belief, rid, mass),
-            -mass.get(kind or "", 0.0),
+            tier,
+            -mass.get(kind or "", 0.0) if weighed else 0.0,
             -like,
             rid not in rooms,
             -round(gain[rid] / GAIN_STEP_M2),
@@ -339,28 +343,32 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     those were found with the probability that two items of one bddl activity share a room type
     (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept otherwise:
     one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms list more
-    trash cans than gardens do. Where each missing object is likeliest, indoors or out, gives the
+    trash cans than gardens do. Before any is found, such furniture is where the missing items are likeliest,
+    with that probability: the weeds' trash can on the lawn, not in the bathrooms that list trash cans
+    (hoe_weeds seed 2). Where each missing object is likeliest, indoors or out, gives the
     mass's ``sides`` (:func:`room_tier`)."""
     goal = agenda.goal
     stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
     items = [s for s in missing if s not in stands and s not in stays]
-    objects: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
-    objects += [(rooms, _set_out(goal, s)) for s, rooms in stands.items()]
     each_item = [(item_rooms(goal, [s]), _set_out(goal, s)) for s in items]
     items_together = (mean_rooms([rooms for rooms, _ in each_item]), any(out for _, out in each_item))
-    parts = [*objects, items_together] if items else objects
     known = [*found, *(kind for s, kind in stays.items() if _set_out(goal, s))]
     together = {kind: n / len(known) for kind, n in Counter(known).items()}
+    share = together_share()
+
+    def beside(rooms: dict[str, float], lead: dict[str, float]) -> dict[str, float]:
+        return {kind: share * lead.get(kind, 0.0) + (1 - share) * rooms.get(kind, 0.0) for kind in {*rooms, *lead}}
 
     def expected(rooms: dict[str, float], with_found: bool) -> dict[str, float]:
-        if not (with_found and together):
-            return rooms
-        share = together_share()
-        return {
-            kind: share * together.get(kind, 0.0) + (1 - share) * rooms.get(kind, 0.0) for kind in {*rooms, *together}
-        }
+        return beside(rooms, together) if with_found and together else rooms
+
+    objects: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
+    for s, rooms in stands.items():  # set out with the items: where they are likeliest, until some are found
+        lead = items_together[0] if _set_out(goal, s) and not together else {}
+        objects.append((beside(rooms, lead) if lead else rooms, _set_out(goal, s)))
+    parts = [*objects, items_together] if items else objects
 
     mass: dict[str, float] = {}
     for rooms, with_found in parts:
