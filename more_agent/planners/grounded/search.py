@@ -267,8 +267,8 @@ def room_to_explore(
     def score(rid: str) -> tuple[bool, int, float, float, bool, int, float, str]:
         kind = belief.room_types.get(rid)
         tier = room_tier(belief, rid, mass)
-        weighed = kind is not None and tier != ELSEWHERE
-        like = max((listed_share(c, kind) for c in cats), default=0.0) if weighed else 0.0
+        weighed = tier != ELSEWHERE  # the last tier: by the floor it hides, not by the little it may hold
+        like = max((listed_share(c, kind) for c in cats), default=0.0) if kind and weighed else 0.0
         return (
             stale(belief, rid),
             tier,
