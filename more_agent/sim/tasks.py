@@ -280,6 +280,16 @@ def _term(term: str, name: Callable[[str], str], bound: dict[str, str]) -> str:
     return bound.get(t) or name(t)
 
 
+def _distributes(quantifier: str, body: ParsedLiteral) -> bool:
+    """Whether the quantified phrase ("every log") may stand in for the variable throughout ``body`` without
+    changing the goal: over a literal or another quantifier, and "every" over an ``and``. Over an ``or`` it may
+    not: "every log on the table or on a log" is not "either every log on the table or every log on a log"."""
+    head = body[0]
+    if head in ("or", "imply") or (head == "not" and body[1][0] in LOGIC_TOKENS):
+        return False
+    return head != "and" or quantifier == "forall"
+
+
 def _phrase(node: ParsedLiteral, name: Callable[[str], str], bound: dict[str, str], declarative: bool = False) -> str:
     head = node[0]
     if head == "and":
@@ -294,7 +304,9 @@ def _phrase(node: ParsedLiteral, name: Callable[[str], str], bound: dict[str, st
         body = node[3] if head == "forn" else node[2]
         what = category_phrase(synset)
         quantified = {"forall": f"every {what}", "exists": f"a {what}"}.get(head, f"exactly {count} {what}(s)")
-        return _phrase(body, name, {**bound, var.lstrip("?"): quantified}, declarative)
+        if _distributes(head, body):
+            return _phrase(body, name, {**bound, var.lstrip("?"): quantified}, declarative)
+        return f"for {quantified}: {_phrase(body, name, {**bound, var.lstrip('?'): f'that {what}'}, declarative)}"
     if head in ("forpairs", "fornpairs"):
         count = node[1][0] if head == "fornpairs" else None
         (var1, _, syn1), (var2, _, syn2) = node[2:4] if count else node[1:3]

@@ -95,3 +95,24 @@ def test_describe_goal_quantifiers_and_negation() -> None:
         "put apple A inside fridge A; put every plate on top of table A; put pack of pasta A inside a bowl; "
         "close fridge A; put a different doll inside each sack"
     )
+
+
+def test_a_quantifier_over_a_choice_or_a_shared_object_keeps_its_scope() -> None:
+    """stacking_wood's goal puts every log on the table or on some log: each log chooses. Carrying "every log"
+    into each branch of the ``or`` read "either every log on the table or every log on log A", another goal.
+    One sack holding three items is not three sacks; "every" still carries over an ``and``."""
+    log = ["?log.n.01", "-", "log.n.01"]
+    goal = [
+        ["forall", log, ["or", ["ontop", "?log.n.01", "?table.n.02_1"], ["ontop", "?log.n.01", "?log.n.01_1"]]],
+        ["exists", ["?sack.n.01", "-", "sack.n.01"],
+         ["and", ["inside", "?apple.n.01_1", "?sack.n.01"], ["inside", "?banana.n.02_1", "?sack.n.01"]]],
+        ["forn", ["2"], log, ["ontop", "?log.n.01", "?table.n.02_1"]],
+        ["forall", log, ["and", ["ontop", "?log.n.01", "?table.n.02_1"], ["not", ["open", "?log.n.01"]]]],
+    ]
+    labels = {"table.n.02_1": "table A", "log.n.01_1": "log A", "apple.n.01_1": "apple A", "banana.n.02_1": "banana A"}
+    assert describe_goal(goal, labels.__getitem__).split("; ") == [
+        "for every log: either put that log on top of table A or put that log on top of log A",
+        "for a sack: put apple A inside that sack and put banana A inside that sack",
+        "put exactly 2 log(s) on top of table A",
+        "put every log on top of table A and close every log",
+    ]
