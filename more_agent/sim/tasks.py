@@ -294,8 +294,9 @@ def _phrase(node: ParsedLiteral, name: Callable[[str], str], bound: dict[str, st
     head = node[0]
     if head == "and":
         return " and ".join(_phrase(c, name, bound, declarative) for c in node[1:])
-    if head == "or":
-        return "either " + " or ".join(_phrase(c, name, bound, declarative) for c in node[1:])
+    if head == "or":  # an "or" inside an "or" is one choice: "either a or b or c", not "either a or either b or c"
+        options = [o for c in node[1:] for o in (c[1:] if c[0] == "or" else [c])]
+        return "either " + " or ".join(_phrase(o, name, bound, declarative) for o in options)
     if head == "imply":
         return f"if {_phrase(node[1], name, bound, True)}, {_phrase(node[2], name, bound, declarative)}"
     if head in ("forall", "exists", "forn"):

@@ -99,11 +99,12 @@ def test_describe_goal_quantifiers_and_negation() -> None:
 
 def test_a_quantifier_over_a_choice_or_a_shared_object_keeps_its_scope() -> None:
     """stacking_wood's goal puts every log on the table or on some log: each log chooses. Carrying "every log"
-    into each branch of the ``or`` read "either every log on the table or every log on log A", another goal.
+    into each branch of the ``or`` read "either every log on the table or every log on log A", another goal
+    (and an ``or`` nested in it, as bddl writes it, "or either").
     One sack holding three items is not three sacks; "every" still carries over an ``and``."""
     log = ["?log.n.01", "-", "log.n.01"]
     goal = [
-        ["forall", log, ["or", ["ontop", "?log.n.01", "?table.n.02_1"], ["ontop", "?log.n.01", "?log.n.01_1"]]],
+        ["forall", log, ["or", ["ontop", "?log.n.01", "?table.n.02_1"], ["or", ["ontop", "?log.n.01", "?log.n.01_1"]]]],
         ["exists", ["?sack.n.01", "-", "sack.n.01"],
          ["and", ["inside", "?apple.n.01_1", "?sack.n.01"], ["inside", "?banana.n.02_1", "?sack.n.01"]]],
         ["forn", ["2"], log, ["ontop", "?log.n.01", "?table.n.02_1"]],
