@@ -366,8 +366,9 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
 
     objects: list[tuple[dict[str, float], bool]] = [({kind: 1.0}, False) for kind in stays.values()]
     for s, rooms in stands.items():  # set out with the items: where they are likeliest, until some are found
-        lead = items_together[0] if _set_out(goal, s) and not together else {}
-        objects.append((beside(rooms, lead) if lead else rooms, _set_out(goal, s)))
+        out = _set_out(goal, s)
+        follows = out and not together and bool(items_together[0])
+        objects.append((beside(rooms, items_together[0]) if follows else rooms, out))
     parts = [*objects, items_together] if items else objects
 
     mass: dict[str, float] = {}
