@@ -2,7 +2,16 @@
 
 from __future__ import annotations
 
-from more_agent.planners.whereabouts import container_prior, container_share, evidence, never_inside, room_prior
+import pytest
+
+from more_agent.planners.whereabouts import (
+    container_prior,
+    container_share,
+    corpus,
+    evidence,
+    never_inside,
+    room_prior,
+)
 
 
 def test_an_item_s_prior_points_to_the_rooms_the_corpus_keeps_it_in() -> None:
@@ -42,3 +51,11 @@ def test_an_item_many_activities_place_and_none_inside_is_kept_in_no_container()
     """Cars stand in gardens and garages in several activities, never inside anything."""
     assert never_inside("car.n.01")
     assert set(room_prior("car.n.01")) <= {"garden", "garage"}
+
+
+def test_reading_the_corpus_prints_nothing(capsys: pytest.CaptureFixture[str]) -> None:
+    """bddl prints what its parser skips (a stray backslash in wash_a_baseball_cap) to stdout: reading the
+    corpus once put that line into the output of every episode, ``--json`` included."""
+    corpus.cache_clear()
+    assert corpus()
+    assert capsys.readouterr().out == ""
