@@ -17,21 +17,15 @@ second), on first use.
 
 from __future__ import annotations
 
-import contextlib
-import io
-import logging
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from itertools import combinations
-from pathlib import Path
 from typing import Any
 
 from more_agent.sim import catalog
 from more_agent.vocabulary import scope_synset
-
-log = logging.getLogger(__name__)
 
 MIN_EVIDENCE = 1
 """Items placed in other activities below which a synset borrows its parents' evidence (its siblings')."""
@@ -63,16 +57,9 @@ class Evidence:
 def corpus() -> dict[str, tuple[Evidence, ...]]:
     """Item synset -> its evidence over every bddl activity (read with bddl's own parser: static knowledge
     of the library, not the episode's task, which planners may not import)."""
-    from bddl.config import ACTIVITY_CONFIGS_PATH
-    from bddl.parsing import parse_domain, parse_problem
-
-    domain, *_ = parse_domain("omnigibson")
     found: dict[str, list[Evidence]] = {}
-    for name in sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir()):
-        with contextlib.redirect_stdout(io.StringIO()) as said:  # bddl prints what it skips to stdout
-            init = parse_problem(name, 0, domain)[2]
-        if said.getvalue():  # wash_a_baseball_cap's stray backslash, once in every episode's output before
-            log.debug("bddl on %s: %s", name, said.getvalue().strip())
+    for name in catalog.activity_names():
+        init = catalog.activity_problem(name)[1]
         for synset, ev in _activity_evidence(name, init):
             found.setdefault(synset, []).append(ev)
     return {s: tuple(evs) for s, evs in found.items()}

@@ -8,13 +8,20 @@ Everything is loaded lazily on first use and cached; nothing is read at import t
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import logging
 import os
 from functools import cache
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from more_agent.errors import unknown_name_error
+
+log = logging.getLogger(__name__)
 
 Vec3 = tuple[float, float, float]
 
@@ -60,6 +67,36 @@ def taxonomy():  # -> bddl.object_taxonomy.ObjectTaxonomy
     from bddl.object_taxonomy import ObjectTaxonomy
 
     return ObjectTaxonomy()
+
+
+@cache
+def activity_names() -> tuple[str, ...]:
+    """All 1016 activity names bddl ships (its definition folders), sorted; read without
+    ``bddl.activity``, which imports networkx."""
+    from bddl.config import ACTIVITY_CONFIGS_PATH
+
+    return tuple(sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir()))
+
+
+@cache
+def _domain_name() -> str:
+    from bddl.parsing import parse_domain
+
+    name: str = parse_domain("omnigibson")[0]
+    return name
+
+
+def activity_problem(name: str) -> tuple[dict[str, list[str]], list[Any], list[Any]]:
+    """Activity ``name``'s problem 0 as bddl's parser reads it: (synset -> scopes, init, goal). The parser
+    prints what it skips to stdout (a stray backslash in wash_a_baseball_cap, once in every episode's
+    output before); that goes to a debug log line instead."""
+    from bddl.parsing import parse_problem
+
+    with contextlib.redirect_stdout(io.StringIO()) as said:
+        _, objects, init, goal = parse_problem(name, 0, _domain_name())
+    if skipped := said.getvalue().strip():
+        log.debug("bddl on %s: %s", name, skipped)
+    return objects, init, goal
 
 
 def scene_names() -> list[str]:

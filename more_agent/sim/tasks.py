@@ -22,7 +22,6 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -111,11 +110,8 @@ def atomic_predicates(parsed: list[ParsedLiteral]) -> set[str]:
 # -- catalogue ------------------------------------------------------------------------------------
 @cache
 def task_names() -> list[str]:
-    """All 1016 activity names bddl ships (its definition folders), sorted; read without
-    ``bddl.activity``, which imports networkx."""
-    from bddl.config import ACTIVITY_CONFIGS_PATH
-
-    return sorted(p.name for p in Path(ACTIVITY_CONFIGS_PATH).iterdir() if p.is_dir())
+    """All 1016 activity names bddl ships, sorted (:func:`~more_agent.sim.catalog.activity_names`)."""
+    return list(catalog.activity_names())
 
 
 @cache
@@ -130,10 +126,7 @@ def load_task(name: str) -> TaskDefinition:
     """Parse an activity (cached per process); unknown names raise a UserError naming the closest."""
     if name not in set(task_names()):
         raise unknown_name_error("task", name, task_names())
-    from bddl.parsing import parse_domain, parse_problem
-
-    domain_name, *_ = parse_domain("omnigibson")
-    _, objects, init, goal = parse_problem(name, 0, domain_name)
+    objects, init, goal = catalog.activity_problem(name)
     return TaskDefinition(
         name=name,
         objects={syn: list(scopes) for syn, scopes in objects.items()},
