@@ -20,7 +20,6 @@ from more_agent.planners.policies import (
 )
 from more_agent.planners.policies.embodiment import PolicyConfig
 from more_agent.planners.policies.skills import (
-    BACK_OUT_M,
     RETRACE_M,
     back_out,
     explore_frontiers,
@@ -240,9 +239,10 @@ class DrivenBody:
 
 def test_a_robot_blocked_in_a_slot_backs_out_through_the_exact_positions_it_came_by() -> None:
     """A final approach left the base in a slot narrower than the map's clearance (Beechwood's car
-    beside the fence): it drives back through the positions it held, not cell centres, to the first
-    with full clearance; standing with full clearance, or with none near, it does not."""
-    grid = np.full((60, 20), FREE)  # [ix, iy], 0.1 m cells; open floor at x < 2 m
+    beside the fence; a bed and a wall, 7 m deep): it drives back through the positions it held, not cell
+    centres, to the first with full clearance; standing with full clearance, or with none within
+    ``RETRACE_M``, it does not."""
+    grid = np.full((110, 20), FREE)  # [ix, iy], 0.1 m cells; open floor at x < 2 m
     grid[20:, :] = OCCUPIED
     grid[20:, 9:13] = FREE  # a slot 0.4 m wide: all of it within the 0.25 m inflation
     occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
@@ -255,7 +255,11 @@ def test_a_robot_blocked_in_a_slot_backs_out_through_the_exact_positions_it_came
     assert free.is_free(*driven[-1]) and not any(free.is_free(*xy) for xy in driven[:-1])
     outside = DrivenBody(way_in[:3])
     assert not back_out(outside, occupancy) and not outside.driven  # type: ignore[arg-type]
-    deep = [(2.1 + 0.07 * k, 1.03) for k in range(int(BACK_OUT_M / 0.07) + 5)]
+    slot = [(1.0 + 0.07 * k, 1.03) for k in range(115)]  # to x = 9 m: 7 m of it in the slot
+    body = DrivenBody(list(slot))
+    assert back_out(body, occupancy)  # type: ignore[arg-type]
+    assert free.is_free(*body.driven[0][-1]) and body.driven[0][-1][0] < 2.0
+    deep = [(2.1 + 0.07 * k, 1.03) for k in range(int(RETRACE_M / 0.07) + 5)]
     assert not back_out(DrivenBody(deep), occupancy)  # type: ignore[arg-type]
 
 

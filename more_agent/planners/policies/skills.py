@@ -67,8 +67,11 @@ def _drive(
     return False, None, "the way is blocked"
 
 
-BACK_OUT_M = 4.0
-"""How far back along its own way the robot retraces, at most, to a place with full clearance."""
+RETRACE_M = 12.0
+"""How far back along its own way the robot retraces, at most (``back_out``, ``way_back``). A slot can run
+deep: under a search order since dropped, packing_picnic_food_into_car seed 1 drove the base along a bed
+in Wainscott_0_garden's bedroom, where the nearest position with full clearance lay over 4 m back (the
+limit for ``back_out`` was 4 m then: 28 steps blocked)."""
 
 
 def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
@@ -76,17 +79,13 @@ def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
     held (each segment was driven before), to the last one with the full clearance of the agent's map:
     a final approach can leave the base in a slot narrower than that clearance (between a car and a
     fence), where paths through grid-cell centres graze what the exact way in missed, every move
-    blocked. False when the robot stands with full clearance, none lies within ``BACK_OUT_M``, or the
+    blocked. False when the robot stands with full clearance, none lies within ``RETRACE_M``, or the
     way back is blocked too."""
     grid = _nav_grid(body, occupancy)
     if grid.is_free(*body.xy):
         return False
-    way = next((w for w in _ways_back(body, BACK_OUT_M) if grid.is_free(*w[-1])), None)
+    way = next((w for w in _ways_back(body, RETRACE_M) if grid.is_free(*w[-1])), None)
     return way is not None and body.follow(way)
-
-
-RETRACE_M = 12.0
-"""How far back along its own way the robot retraces, at most, to a place from which its map leads on."""
 
 
 def way_back(
