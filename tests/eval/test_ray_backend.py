@@ -1,4 +1,5 @@
-"""Ray (optional extra, installed for tests): same episodes and metrics as the process pool; LLM limit."""
+"""Ray (marker ``ray``: the optional extra more-agent[ray], installed by .ci/run in its own step): same
+episodes and metrics as the process pool; LLM limit."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from more_agent.eval.harness import evaluate
 from more_agent.eval.metrics import by_system
 from more_agent.eval.store import RunConfig
 
-ray = pytest.importorskip("ray", reason="Ray is the optional extra more-agent[ray]")
+pytestmark = pytest.mark.ray
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -22,6 +23,8 @@ def config(fn: str, **kw: object) -> RunConfig:
 
 @pytest.fixture(scope="module")
 def local_ray():
+    import ray
+
     mp = pytest.MonkeyPatch()
     mp.setenv("PYTHONPATH", str(REPO))  # Ray workers import the fake episodes from tests/
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
