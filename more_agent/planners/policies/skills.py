@@ -68,10 +68,8 @@ def _drive(
 
 
 RETRACE_M = 12.0
-"""How far back along its own way the robot retraces, at most (``back_out``, ``way_back``). A slot can run
-deep: under a search order since dropped, packing_picnic_food_into_car seed 1 drove the base along a bed
-in Wainscott_0_garden's bedroom, where the nearest position with full clearance lay over 4 m back (the
-limit for ``back_out`` was 4 m then: 28 steps blocked)."""
+"""How far back along its own way the robot retraces, at most, in ``back_out`` and ``way_back`` alike: a
+slot can run deep (along a bed in Wainscott_0_garden's bedroom, full clearance lay over 4 m back)."""
 
 
 def back_out(body: Embodiment, occupancy: OccupancyMap) -> bool:
