@@ -1,6 +1,6 @@
 """Print an episode step by step: where the robot stands, what the planner chose and why, what came of it.
 
-    python scripts/trace_episode.py TASK SEED [--planner grounded] [--descriptions named|paper] [--truth]
+    python scripts/trace_episode.py TASK SEED [--planner grounded] [--descriptions named|paper] [--truth] [--map OUT.png]
 
 One line per high-level step: the robot's region (and the room type the planner gives it), the step and
 its arguments, the planner's note (the grounded planner's reason, an LLM's reasoning, the oracle's
@@ -8,7 +8,11 @@ literal) and the outcome. For the ``grounded`` planner a second line lists the r
 left (type, frontier count, distance from the robot): that is where the search may go next. It is the
 tool that traces a lost episode to the mechanism that lost it (docs/benchmarks.md). ``--truth`` first
 prints where the world put each task object (room, what it lies in or on, metres from the start) and
-names the room the robot truly stands in at each step: what no planner is told.
+names the room the robot truly stands in at each step: what no planner is told. ``--map OUT.png`` (the
+``grounded`` planner) then draws the robot's own occupancy map as the episode left it, its path, where it
+stood at each step (numbered), the frontiers left, and where the world put each task object: green once
+the robot saw it, red if it never did. A search's blind spots show at a glance (an item behind a tree, a
+lawn left for the far end, a checkout's back row).
 """
 
 from __future__ import annotations
@@ -16,22 +20,31 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
 
 from more_agent.eval.episode import run_episode
 from more_agent.planners.base import Planner, Step, make_planner
 from more_agent.planners.grounded import GroundedPlanner
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.robot import ActionResult
-from more_agent.sim.instantiate import instantiate
+from more_agent.sim.instantiate import TaskInstance, instantiate
 from more_agent.sim.world import World
 
 NOTE_CHARS = 160
 """An LLM's reasoning is clipped to this many characters a line."""
 
 
-def traced(planner: Planner, out: Callable[[str], None] = print, world: World | None = None) -> Planner:
+def traced(
+    planner: Planner,
+    out: Callable[[str], None] = print,
+    world: World | None = None,
+    stops: list[tuple[float, float]] | None = None,
+) -> Planner:
     """``planner`` with its ``decide`` and ``execute`` wrapped to print each step through ``out``; with the
-    episode's ``world`` (its rooms never move) each step also names the room the robot truly stands in."""
+    episode's ``world`` (its rooms never move) each step also names the room the robot truly stands in.
+    ``stops`` collects where the robot stands at each step (the ``grounded`` planner)."""
     decide, execute = planner.decide, planner.execute
     steps = [0]
 
@@ -40,6 +53,9 @@ def traced(planner: Planner, out: Callable[[str], None] = print, world: World | 
         out(f"{steps[0]:3d} {where(planner, world):28s} {step.name}({', '.join(step.arguments)})  # {clip(step.note)}")
         if isinstance(planner, GroundedPlanner):
             out(f"    open: {frontier_rooms(planner)}")
+            if stops is not None and planner.graph is not None:
+                x, y = planner.graph.robot.position[:2]
+                stops.append((x, y))
         return step
 
     def traced_execute(action: Step) -> ActionResult:
@@ -83,18 +99,26 @@ def clip(text: str) -> str:
     return line if len(line) <= NOTE_CHARS else line[: NOTE_CHARS - 1] + "…"
 
 
-def trace(spec: EpisodeSpec, out: Callable[[str], None] = print, world: World | None = None) -> EpisodeRecord:
-    """Run ``spec`` with its planner traced through ``out`` (``world``: see :func:`traced`); print and
-    return the record's outcome."""
-    record = run_episode(spec, planner=traced(make_planner(spec.planner, spec.llm), out, world))
+def trace(
+    spec: EpisodeSpec,
+    out: Callable[[str], None] = print,
+    world: World | None = None,
+    *,
+    planner: Planner | None = None,
+    stops: list[tuple[float, float]] | None = None,
+) -> EpisodeRecord:
+    """Run ``spec`` with its planner (or ``planner``) traced through ``out`` (``world``, ``stops``: see
+    :func:`traced`); print and return the record's outcome."""
+    planner = planner or make_planner(spec.planner, spec.llm)
+    record = run_episode(spec, planner=traced(planner, out, world, stops))
     failure = record.failure.cause if record.failure is not None else "-"
     out(f"success={record.success} steps={record.high_level_steps} failure={failure} error={record.error or '-'}")
     return record
 
 
-def truth(spec: EpisodeSpec, out: Callable[[str], None] = print) -> World:
+def truth(spec: EpisodeSpec, out: Callable[[str], None] = print) -> TaskInstance:
     """Print where the world of ``spec`` puts each task object: room, parent, relation, distance from the
-    start; return that world."""
+    start; return that task instance (its world, the same every time for the spec)."""
     instance = instantiate(
         spec.task, spec.scene, spec.seed, start=spec.start, distractors=spec.distractors, descriptions=spec.descriptions
     )
@@ -106,7 +130,45 @@ def truth(spec: EpisodeSpec, out: Callable[[str], None] = print) -> World:
         if obj is not None:
             gap = math.dist(start, obj.center[:2])
             out(f"  {scope:32s} {name:40s} {obj.room} {obj.relation or ''} {obj.parent or ''} {gap:.0f}m")
-    return world
+    return instance
+
+
+def draw_map(planner: GroundedPlanner, instance: TaskInstance, stops: list[tuple[float, float]], path: Path) -> None:
+    """Write ``path`` (PNG): the robot's occupancy map as the episode left it (grey unknown, white free,
+    black occupied), its path, where it stood at each step, the frontiers left and the task objects of
+    ``instance`` (the episode's world: instance ids match), green once observed, red if never."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    graph, body = planner.graph, planner.body
+    if graph is None or graph.occupancy is None or body is None:
+        raise SystemExit("--map needs an episode of the grounded planner that has sensed")
+    occ = graph.occupancy
+    shade = np.array([0.6, 1.0, 0.1])[occ.grid.T.clip(0, 2)]
+    (x0, y0), (nx, ny), res = occ.origin_xy, occ.grid.shape, occ.resolution_m
+    fig, ax = plt.subplots(figsize=(10, 10))
+    ax.imshow(shade, cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x0 + nx * res, y0, y0 + ny * res))
+    trajectory = np.asarray(body.trajectory)
+    ax.plot(trajectory[:, 0], trajectory[:, 1], "-", color="tab:blue", lw=0.8, label="path")
+    for k, (x, y) in enumerate(stops):
+        ax.plot(x, y, "o", color="tab:purple", ms=4)
+        ax.annotate(str(k), (x, y), fontsize=6, color="tab:purple", xytext=(2, 2), textcoords="offset points")
+    frontiers = np.array([f for r in graph.regions.values() for f in r.frontiers] or np.empty((0, 2)))
+    ax.plot(frontiers[:, 0], frontiers[:, 1], ".", color="tab:cyan", ms=3, label="frontiers left")
+    for name in sorted(set(instance.scope.values())):
+        obj = instance.world.objects.get(name)
+        if obj is None or obj.kind == "floor":
+            continue
+        colour = "tab:green" if obj.instance_id in body.observed else "tab:red"
+        ax.plot(obj.center[0], obj.center[1], "*", color=colour, ms=9)
+        ax.annotate(name, (obj.center[0], obj.center[1]), fontsize=6, color=colour, xytext=(3, -6), textcoords="offset points")
+    ax.set_title(f"{instance.task} in {instance.scene}: the robot's map, stops, and the task objects", fontsize=9)
+    ax.set_aspect("equal")
+    ax.legend(loc="upper right", fontsize=7)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 def main() -> None:
@@ -117,11 +179,20 @@ def main() -> None:
     parser.add_argument("--llm", default=None, help="LLM spec for an LLM planner (docs/llm.md)")
     parser.add_argument("--descriptions", default="named", choices=["named", "paper"])
     parser.add_argument("--truth", action="store_true", help="first print where the task's objects are")
+    parser.add_argument("--map", type=Path, default=None, help="draw the robot's map and the task objects (PNG)")
     args = parser.parse_args()
     spec = EpisodeSpec(
         task=args.task, seed=args.seed, planner=args.planner, llm=args.llm, descriptions=args.descriptions
     )
-    trace(spec, world=truth(spec) if args.truth else None)
+    planner = make_planner(spec.planner, spec.llm)
+    if args.map and not isinstance(planner, GroundedPlanner):
+        parser.error("--map draws the grounded planner's own map")
+    instance = truth(spec, print if args.truth else lambda _: None) if args.truth or args.map else None
+    stops: list[tuple[float, float]] = []
+    trace(spec, world=instance.world if instance and args.truth else None, planner=planner, stops=stops)
+    if args.map and instance is not None and isinstance(planner, GroundedPlanner):
+        draw_map(planner, instance, stops, args.map)
+        print(f"map: {args.map}")
 
 
 if __name__ == "__main__":

@@ -6,6 +6,10 @@ import importlib.util
 from pathlib import Path
 from types import ModuleType
 
+import numpy as np
+from PIL import Image
+
+from more_agent.planners.grounded import GroundedPlanner
 from more_agent.records import EpisodeSpec
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -25,7 +29,7 @@ def test_the_trace_prints_each_step_its_reason_and_outcome_and_where_the_robot_t
     tracer = trace_module()
     spec = EpisodeSpec(task="store_produce", scene=str(TINY), seed=0, planner="grounded")
     lines: list[str] = []
-    world = tracer.truth(spec, lines.append)
+    world = tracer.truth(spec, lines.append).world
     assert world.objects and ": " in lines[0] and any("ontop" in s or "inside" in s for s in lines[1:])
     told = len(lines)
     record = tracer.trace(spec, lines.append, world)
@@ -37,3 +41,17 @@ def test_the_trace_prints_each_step_its_reason_and_outcome_and_where_the_robot_t
     assert [s.startswith("    -> ok") for s in outcomes] == [a.ok for a in record.actions]
     assert sum(s.startswith("    open: ") for s in lines) == len(steps)
     assert lines[-1].startswith(f"success={record.success} steps={record.high_level_steps}")
+
+
+def test_the_map_shows_the_robots_own_grid_its_stops_and_which_task_objects_it_saw(tmp_path: Path) -> None:
+    tracer = trace_module()
+    spec = EpisodeSpec(task="store_produce", scene=str(TINY), seed=0, planner="grounded")
+    instance = tracer.truth(spec, lambda _: None)
+    planner = GroundedPlanner()
+    stops: list[tuple[float, float]] = []
+    record = tracer.trace(spec, lambda _: None, planner=planner, stops=stops)
+    assert len(stops) == record.high_level_steps  # one stop drawn per step
+    tracer.draw_map(planner, instance, stops, tmp_path / "map.png")
+    picture = np.asarray(Image.open(tmp_path / "map.png").convert("RGB")).astype(int)
+    green = (picture[..., 1] > 120) & (picture[..., 0] < 90) & (picture[..., 2] < 90)
+    assert record.success and green.sum() > 20  # the solved episode saw its task objects: green stars
