@@ -22,6 +22,7 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from more_agent.eval.episode import run_episode
@@ -31,6 +32,8 @@ from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.robot import ActionResult
 from more_agent.sim.instantiate import TaskInstance, instantiate
 from more_agent.sim.world import World
+from more_agent.viz.graph_plot import draw_occupancy
+from more_agent.viz.trajectory import draw_trajectory
 
 NOTE_CHARS = 160
 """An LLM's reasoning is clipped to this many characters a line."""
@@ -134,24 +137,15 @@ def truth(spec: EpisodeSpec, out: Callable[[str], None] = print) -> TaskInstance
 
 
 def draw_map(planner: GroundedPlanner, instance: TaskInstance, stops: list[tuple[float, float]], path: Path) -> None:
-    """Write ``path`` (PNG): the robot's occupancy map as the episode left it (grey unknown, white free,
-    black occupied), its path, where it stood at each step, the frontiers left and the task objects of
-    ``instance`` (the episode's world: instance ids match), green once observed, red if never."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Write ``path`` (PNG): the robot's occupancy map as the episode left it (``draw_occupancy``), its path,
+    where it stood at each step, the frontiers left and the task objects of ``instance`` (instantiated again
+    from the episode's spec, so its instance ids are the episode's), green once observed, red if never."""
     graph, body = planner.graph, planner.body
     if graph is None or graph.occupancy is None or body is None:
         raise SystemExit("--map needs an episode of the grounded planner that has sensed")
-    occ = graph.occupancy
-    shade = np.array([0.6, 1.0, 0.1])[occ.grid.T.clip(0, 2)]
-    (x0, y0), (nx, ny), res = occ.origin_xy, occ.grid.shape, occ.resolution_m
     fig, ax = plt.subplots(figsize=(10, 10))
-    ax.imshow(shade, cmap="gray", vmin=0, vmax=1, origin="lower", extent=(x0, x0 + nx * res, y0, y0 + ny * res))
-    trajectory = np.asarray(body.trajectory)
-    ax.plot(trajectory[:, 0], trajectory[:, 1], "-", color="tab:blue", lw=0.8, label="path")
+    draw_occupancy(ax, graph.occupancy)
+    draw_trajectory(ax, body.trajectory, color="tab:blue")
     for k, (x, y) in enumerate(stops):
         ax.plot(x, y, "o", color="tab:purple", ms=4)
         ax.annotate(str(k), (x, y), fontsize=6, color="tab:purple", xytext=(2, 2), textcoords="offset points")
@@ -163,7 +157,9 @@ def draw_map(planner: GroundedPlanner, instance: TaskInstance, stops: list[tuple
             continue
         colour = "tab:green" if obj.instance_id in body.observed else "tab:red"
         ax.plot(obj.center[0], obj.center[1], "*", color=colour, ms=9)
-        ax.annotate(name, (obj.center[0], obj.center[1]), fontsize=6, color=colour, xytext=(3, -6), textcoords="offset points")
+        ax.annotate(
+            name, (obj.center[0], obj.center[1]), fontsize=6, color=colour, xytext=(3, -6), textcoords="offset points"
+        )
     ax.set_title(f"{instance.task} in {instance.scene}: the robot's map, stops, and the task objects", fontsize=9)
     ax.set_aspect("equal")
     ax.legend(loc="upper right", fontsize=7)

@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from PIL import Image  # noqa: E402
@@ -21,15 +22,20 @@ from more_agent.scene_graph.model import OccupancyMap, SceneGraph  # noqa: E402
 _OCC_CMAP = ListedColormap(["#d9d9d9", "#ffffff", "#303030"])  # unknown, free, occupied
 
 
+def draw_occupancy(ax: Axes, occ: OccupancyMap) -> None:
+    """The BEV grid on ``ax`` in world coordinates: unknown grey, free white, occupied dark."""
+    x0, y0, x1, y1 = occ.frame.bounds(occ.grid.shape)
+    ax.imshow(
+        occ.grid.T, origin="lower", extent=(x0, x1, y0, y1), cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest"
+    )  # imshow draws [row, col]: y up the rows
+
+
 def scene_graph_png(graph: SceneGraph, *, title: str | None = None, dpi: int = 120) -> bytes:
     """The picture as PNG bytes. World x is to the right, y up."""
     fig, ax = plt.subplots(figsize=(8, 8))
     occ = graph.occupancy
     if occ is not None:
-        x0, y0, x1, y1 = occ.frame.bounds(occ.grid.shape)
-        ax.imshow(
-            occ.grid.T, origin="lower", extent=(x0, x1, y0, y1), cmap=_OCC_CMAP, vmin=0, vmax=2, interpolation="nearest"
-        )  # imshow draws [row, col]: y up the rows
+        draw_occupancy(ax, occ)
         known = np.argwhere(occ.grid != 0)
         if len(known):  # show the explored part, with a metre around it
             margin = occ.resolution_m / 2 + 1.0
