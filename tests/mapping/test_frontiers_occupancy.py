@@ -3,7 +3,7 @@
 import numpy as np
 
 from more_agent.mapping import Grid, VoxelMap, depth_to_points, frontier_points, visible_unknown_area
-from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN
+from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN, zeroed
 from tests.scene_graph.boxworld import CID, Box, camera_pose, intrinsics, render
 
 
@@ -102,6 +102,16 @@ def test_growth_in_every_direction_keeps_the_map_and_brings_in_only_unknown_cell
         assert vmap.shape != shape
         assert np.allclose(vmap.instance_voxels()[9], crate_voxels, rtol=0, atol=1e-9)
         assert int((vmap.top_class >= 0).sum()) == seen and int((vmap.cls > 0).sum()) == filled
+
+
+def test_zeroed_buffers_are_empty_writable_and_their_own() -> None:
+    """The voxel buffers' allocation: zeros of the asked shape and type, writable, sharing no memory with
+    another buffer; an empty shape works too."""
+    a, b = zeroed((300, 200, 53), np.uint16), zeroed((300, 200, 53), np.uint16)
+    assert a.shape == (300, 200, 53) and a.dtype == np.uint16 and not a.any()
+    a[7, 9, 11] = 5
+    assert a[7, 9, 11] == 5 and not b.any() and not np.shares_memory(a, b)
+    assert zeroed((0, 0, 53), np.int32).shape == (0, 0, 53)
 
 
 def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
