@@ -47,7 +47,8 @@ class ActionResult(Outcome[FailureReason]):
     path: list[XY] = field(default_factory=list)
     """Robot base positions visited, start and end included, when the robot moved."""
     blocking: str | None = None
-    """The closed door in the way, when ``reason`` is PATH_BLOCKED_BY_DOOR."""
+    """The closed door in the way, when ``reason`` is PATH_BLOCKED_BY_DOOR, named as the action named its target:
+    its label for a planner (what it can open; None while the robot has no label for it)."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -69,11 +69,16 @@ class NoisyRobot:
         self.inner.turn(angle)
 
     def act(self, action: str, target: str = "") -> ActionResult:
-        """The world action on the real object behind ``target``; its feedback names it as perceived."""
+        """The world action on the real object behind ``target``; its feedback and the door in its way name
+        objects as perceived."""
         real = self.noise.real_label(target)
         result = self.inner.act(action, real)
-        feedback = self.noise.perceived_text(result.feedback, {real: target} if real and real != target else {})
-        return result if feedback == result.feedback else replace(result, feedback=feedback)
+        acted_on = {real: target} if real and real != target else {}
+        feedback = self.noise.perceived_text(result.feedback, acted_on)
+        door = result.blocking and self.noise.perceived_text(result.blocking, acted_on)
+        if (feedback, door) == (result.feedback, result.blocking):
+            return result
+        return replace(result, feedback=feedback, blocking=door)
 
     def reach_distance(self, target: str) -> float | None:
         return self.inner.reach_distance(self.noise.real_label(target))

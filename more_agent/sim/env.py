@@ -522,15 +522,20 @@ class SimRobot:
         self._steps += 1
 
     def act(self, action: str, target: str = "") -> ActionResult:
-        """One magic action of the env on ``target`` (a world name or label); its motion joins the odometry."""
+        """One magic action of the env on ``target`` (a world name or label); its motion joins the odometry.
+        A door in the way is named as ``target`` was: by its label (None while it has none) for a target
+        named by label, by its world name for one named so (the privileged oracle)."""
         info = self._step(action, target=target)
+        blocking = info["blocking"]
+        if blocking is not None and target.strip() not in self._world.objects:
+            blocking = self._labels.label(blocking) or None
         result = ActionResult(
             ok=info["action_ok"],
             reason=FailureReason(info["reason"]) if info["reason"] else None,
             feedback=info["feedback"],
             low_level_steps=info["low_level_steps"],
             path=info["path"],
-            blocking=info["blocking"],
+            blocking=blocking,
         )
         self._steps += result.low_level_steps
         self._trajectory.extend((float(x), float(y)) for x, y in result.path[1:])

@@ -20,6 +20,8 @@ from more_agent.sim.actions import (
     place_inside,
     place_ontop,
 )
+from more_agent.sim.env import SimRobot
+from more_agent.sim.labels import InstanceLabels
 from tests.sim.test_navgrid import labelled, two_room_world
 
 
@@ -91,6 +93,18 @@ def test_navigate_ends_free_within_reach_facing_object_and_counts_steps():
     assert abs(math.atan2(bowl[1] - end[1], bowl[0] - end[0]) - world.robot.yaw) < 1e-6
     length = sum(math.dist(a, b) for a, b in zip(result.path, result.path[1:]))
     assert result.low_level_steps >= math.ceil(length / 0.075)
+
+
+def test_the_robot_names_the_door_in_the_way_as_its_target_was_named():
+    """A planner that acts on labels is told the door's label, which it can open (never the world's name for
+    it); the privileged oracle, acting on world names, the world name."""
+    world = two_room_world(door_open=False)
+    by_label = SimRobot(world, labels=labelled(world)).act("grasp", "bowl A")
+    assert by_label.reason is FailureReason.PATH_BLOCKED_BY_DOOR and by_label.blocking == "door A"
+    assert SimRobot(world, labels=labelled(world)).act("grasp", "bowl_0").blocking == "door_0"
+    unlabelled = InstanceLabels()
+    unlabelled.reserve(world.get("bowl_0"))  # the bowl seen, the door not yet
+    assert SimRobot(world, labels=unlabelled).act("grasp", "bowl A").blocking is None
 
 
 def test_closed_door_blocks_navigation_with_the_door_named_then_opening_it_helps():

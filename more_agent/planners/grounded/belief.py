@@ -65,6 +65,9 @@ class Belief:
     """Containers opened to look inside, one step after the other (``search.OPENS_BEFORE_EXPLORING``)."""
     fruitless: Counter[str] = field(default_factory=Counter)
     """Region id -> explore() calls in a row that revealed no new object (``search.FRUITLESS_EXPLORES``)."""
+    door_in_the_way: str | None = None
+    """The closed door an approach reported in its way (``ActionResult.blocking``), opened next: as the
+    oracle does, and as a reader of the feedback "the way to car A is blocked by closed door C" would."""
 
 
 def learn_from_graph(belief: Belief, graph: SceneGraph) -> None:
@@ -188,6 +191,8 @@ def learn_from_outcome(belief: Belief, goal: TaskGoal, action: Step, outcome: St
             if outcome.news:  # its room shows more: explore it again
                 belief.fruitless[target.region_id or ""] = 0
     belief.fruitless_looks = 0 if outcome.news else belief.fruitless_looks + (action.name == "navigate")
+    if result.reason is FailureReason.PATH_BLOCKED_BY_DOOR and result.blocking is not None:
+        belief.door_in_the_way = result.blocking
     if not result.ok and isinstance(target, ObjectNode):
         count_failure(belief, goal, action, target.label, outcome)
 

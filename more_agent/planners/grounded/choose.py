@@ -28,6 +28,12 @@ def choose(belief: Belief, sit: Situation, agenda: Agenda) -> Choice:
         return Choice(Step(DONE, note="every goal literal holds in the scene graph", gave_up=gave_up))
     held_node = sit.graph.held_object
     held = held_node.label if held_node is not None else None
+    door = door_in_the_way(belief, sit)
+    if door is not None:
+        note = f"{door} blocks the way"
+        return (
+            put_down(belief, sit, agenda, held) if held is not None else object_step(sit, "go_to_and_open", door, note)
+        )
     if held is not None:
         choice = place_held(belief, sit, agenda, held, [lit for lit, h in pending if h is False])
         if choice is not None:
@@ -43,6 +49,17 @@ def choose(belief: Belief, sit: Situation, agenda: Agenda) -> Choice:
     # Nothing to act on now: find what is unseen, else what is out of reach.
     missing = next((lit for lit, h in pending if h is None), pending[0][0])
     return search(belief, sit, agenda, missing, held)
+
+
+def door_in_the_way(belief: Belief, sit: Situation) -> str | None:
+    """The closed door the last blocked approach reported (``Belief.door_in_the_way``) while the step's graph
+    shows it closed and it is not given up; forgotten once open, unseen or given up."""
+    label = belief.door_in_the_way
+    door = sit.graph.objects.get(label) if label is not None else None
+    if door is None or door.open is not False or door.label in belief.dropped:
+        belief.door_in_the_way = None
+        return None
+    return door.label
 
 
 def place_held(belief: Belief, sit: Situation, agenda: Agenda, held: str, unmet: list[Literal]) -> Choice | None:
