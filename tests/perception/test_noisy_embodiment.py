@@ -13,6 +13,7 @@ from more_agent.scene_graph import SceneGraph
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.scene import load_scene
+from tests.sim.test_navgrid import labelled, two_room_world
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 TASK = "putting_shopping_away"
@@ -84,3 +85,22 @@ def test_feedback_names_every_confused_object_as_perceived() -> None:
     text = f"cannot place {real} on {other_real}; {real}B stays"  # a longer label is not touched
     assert noise.perceived_text(text, {}) == f"cannot place {fresh} on {other_fresh}; {real}B stays"
     assert noise.perceived_text(text, {real: "bowl Z"}).startswith("cannot place bowl Z on ")  # the target's label
+
+
+class _Renamed:
+    """The two calls ``NoisyRobot.act`` makes of its perception, for a perception that saw door A as
+    wardrobe B: the made-up label turned into the real one, and back in what the action reports."""
+
+    def real_label(self, label: str) -> str:
+        return "door A" if label == "wardrobe B" else label
+
+    def perceived_text(self, text: str, acted_on: dict[str, str]) -> str:
+        return text.replace("door A", "wardrobe B")
+
+
+def test_the_door_in_the_way_is_named_as_perceived() -> None:
+    """A planner is told the door in its way by the label its perception gave it, as in the feedback."""
+    world = two_room_world(door_open=False)
+    robot = NoisyRobot(SimRobot(world, labels=labelled(world)), _Renamed())  # type: ignore[arg-type]
+    blocked = robot.act("grasp", "bowl A")
+    assert blocked.blocking == "wardrobe B" and "wardrobe B" in blocked.feedback and "door A" not in blocked.feedback
