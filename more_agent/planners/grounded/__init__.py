@@ -46,9 +46,9 @@ Every step (MPC style) it rebuilds the scene graph and:
    gives up with ``done`` when nothing is left to try.
 
 An approach that reports a closed door in its way (``ActionResult.blocking``, the door's label) has that
-door opened next, the hand freed first, as the oracle does. An action that fails twice the same way (its typed reason and the door in the way) is not repeated: its
-target is dropped from the bindings (another instance is taken) or, for a named instance, the planner
-gives up. An object that cannot be picked up is dropped at once (a category can be both: a store's
+door opened next, the hand freed first, as the oracle does. An action that fails twice the same way (its
+typed reason and the door in the way) is not repeated: its target is dropped from the bindings (another
+instance is taken) or, for a named instance, the planner gives up. An object that cannot be picked up is dropped at once (a category can be both: a store's
 cartons are furniture, a task's are items). Regions are labelled with the room type their furniture fits best
 (:mod:`more_agent.planners.room_types`).
 
@@ -57,7 +57,8 @@ each observation and each executed step; the next step is chosen by functions of
 step's :class:`~.situation.Situation` and the goal's :class:`~.agenda.Agenda` (``choose.py``, the
 search in ``search.py``, the steps on objects and floors in ``steps.py``, the literals in
 ``literals.py``), which change nothing but the bindings (and forget a door in the way once it is open):
-a goal scope is bound the first time a choice needs it (``belief.bind``) and stays bound. ``planner.py`` holds the planner protocol around them.
+a goal scope is bound the first time a choice needs it (``belief.bind``) and stays bound. ``planner.py``
+holds the planner protocol around them.
 """
 
 from more_agent.planners.grounded.planner import GroundedPlanner

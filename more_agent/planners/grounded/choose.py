@@ -30,10 +30,9 @@ def choose(belief: Belief, sit: Situation, agenda: Agenda) -> Choice:
     held = held_node.label if held_node is not None else None
     door = door_in_the_way(belief, sit)
     if door is not None:
-        note = f"{door} blocks the way"
-        return (
-            put_down(belief, sit, agenda, held) if held is not None else object_step(sit, "go_to_and_open", door, note)
-        )
+        if held is not None:
+            return put_down(belief, sit, agenda, held)
+        return object_step(sit, "go_to_and_open", door, f"{door} blocks the way")
     if held is not None:
         choice = place_held(belief, sit, agenda, held, [lit for lit, h in pending if h is False])
         if choice is not None:
