@@ -58,6 +58,7 @@ ErrorKind = Literal["llm", "input", "crash"]
 input was bad (unknown task or scene, a task that cannot be instantiated), or code raised / a worker died."""
 
 FailureCause = Literal[
+    "unsatisfiable",
     "never_observed",
     "unreachable",
     "subpolicy_failure",

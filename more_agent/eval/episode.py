@@ -187,7 +187,13 @@ def run_episode(
         if perception is not None:
             record.misperceived = perception.misperceived(sorted(set(scope.values())))
             record.perception_aliases = dict(perception.aliases)
-    record.failure = classify_failure(record, world, labels, goals.objects if goals is not None else ())
+    record.failure = classify_failure(
+        record,
+        world,
+        labels,
+        goals.objects if goals is not None else (),
+        satisfiable=record.success or goals is None or goals.satisfiable,  # solved only when an episode is lost
+    )
     if folder is not None:
         t = time.perf_counter()
         folder.write_map(record, world, labels, set(scope.values()))

@@ -31,6 +31,7 @@ from more_agent.skills import SKILLS
 CAUSE_ORDER: tuple[FailureCause, ...] = (
     "llm_error",
     "other",
+    "unsatisfiable",
     "done_not_called",
     "wrong_instance",
     "misperceived",
@@ -60,17 +61,23 @@ def is_reach_failure(action: ActionRecord) -> bool:
 
 
 def classify_failure(
-    record: EpisodeRecord, world: World | None, labels: InstanceLabels | None, goal_objects: Iterable[str] = ()
+    record: EpisodeRecord,
+    world: World | None,
+    labels: InstanceLabels | None,
+    goal_objects: Iterable[str] = (),
+    satisfiable: bool = True,
 ) -> Failure | None:
     """The failure of a finished episode (None for a success); see the module docstring. ``goal_objects``: the
     objects the goal may use (``GoalChecker.objects``: any ground option's, any quantifier's range), none of
-    them a wrong instance."""
+    them a wrong instance. ``satisfiable``: whether any state meets the goal (``GoalChecker.satisfiable``)."""
     if record.success:
         return None
     if record.error_kind == "llm":
         return Failure(cause="llm_error", detail=record.error or "")
     if record.error is not None or world is None or labels is None:
         return Failure(cause="other", detail=record.error or "the episode did not run")
+    if not satisfiable:
+        return Failure(cause="unsatisfiable", detail="no state meets the goal, whatever the robot does (docs/tasks.md)")
     ended = describe(record.termination) if record.termination not in (None, "done") else ""
     if record.all_goals_met:
         return Failure(cause="done_not_called", detail=ended or "every goal condition held; done() never called")

@@ -16,6 +16,7 @@ progress (TP). The oracle reads the same option as structured ``Literal``s.
 from __future__ import annotations
 
 import copy
+import functools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -29,6 +30,7 @@ from more_agent.records import GoalCondition
 from more_agent.sim.ambiguity import scope_groups
 from more_agent.sim.bddl_backend import ScopeObject, WorldBackend
 from more_agent.sim.predicates import holds
+from more_agent.sim.satisfiable import satisfiable
 from more_agent.sim.world import World
 
 if TYPE_CHECKING:
@@ -137,6 +139,11 @@ class GoalChecker:
         """The world objects the goal may use: those some ground option names and every instance a quantifier
         ranges over (any four of the seven knives; bddl keeps 20 options, which name six of them)."""
         return self._ranged | {arg for option in self._literals for lit in option for arg in lit.args}
+
+    @functools.cached_property
+    def satisfiable(self) -> bool:
+        """Whether any state at all meets the goal (:func:`~more_agent.sim.satisfiable.satisfiable`)."""
+        return satisfiable(self._goal)
 
     def ground_literals(self, option_index: int) -> list[Literal]:
         """The conjuncts of one ground option, as structured literals over world names."""

@@ -159,3 +159,11 @@ def test_a_success_on_floor_conditions_has_full_rtp() -> None:
     assert record.success and all("floor" in " ".join(c.objects) for c in record.goal_conditions)
     assert "floor_garden_0" not in record.observed_objects
     assert rtp(record) == 1.0
+
+
+def test_an_episode_of_a_goal_no_state_meets_is_lost_as_unsatisfiable() -> None:
+    # stacking_wood: every log on the table or on a log, exactly two on the table, exactly two on a log, of six.
+    lost = run_episode(EpisodeSpec(task="stacking_wood", seed=0, planner="oracle"), planner=_DoneAtOnce())
+    assert lost.failure is not None and lost.failure.cause == "unsatisfiable"
+    given_up = run_episode(SPEC, planner=_DoneAtOnce())  # a goal some state meets: the trace decides the cause
+    assert given_up.failure is not None and given_up.failure.cause not in ("unsatisfiable", None)

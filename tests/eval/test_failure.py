@@ -78,6 +78,11 @@ def test_each_cause_from_the_trace(world: World, labels: InstanceLabels) -> None
     assert cause(_record(actions=invalid)) == "invalid_llm_answers"
     assert cause(_record(done_called=True, termination="done")) == "done_early"
     assert cause(_record(high_level_steps=50, termination="step_limit")) == "step_limit"
+    unseen = _record(observed_objects=["bottom_cabinet_0"])
+    impossible = classify_failure(unseen, world, labels, satisfiable=False)  # no robot meets it, seen or not
+    assert impossible is not None and impossible.cause == "unsatisfiable"
+    timed_out = _record(error="LLM error (LLMTimeout): slow", error_kind="llm")
+    assert classify_failure(timed_out, world, labels, satisfiable=False).cause == "llm_error"  # type: ignore[union-attr]
     detail = classify_failure(_record(observed_objects=["bottom_cabinet_0"]), world, labels)
     assert detail is not None and detail.detail == "never observed canned_food A"  # labels, as the robot knows them
 
