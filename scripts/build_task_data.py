@@ -1,11 +1,14 @@
 """Regenerate ``more_agent/data/task_data.json``: ``python scripts/build_task_data.py [--out PATH | --check]``.
 
 For every bddl activity: the suitable scenes (``tasks.compute_suitable_scenes``), object and goal
-literal counts, whether the goal is pure rearrangement, and whether it instantiates in its first
-suitable scene with seed 0 (else why not). The behavior-rearrange set is derived from these.
+literal counts, whether the goal is pure rearrangement, whether it instantiates in its first
+suitable scene with seed 0 (else why not) and whether any state meets its goal there
+(``GoalChecker.satisfiable``). The behavior-rearrange set is derived from these: instantiable,
+satisfiable rearrangement goals.
 Takes a few minutes, most of it generating the 51 scene plans once. It prints how many of the
 1016 activities instantiate (the figure docs/tasks.md reports) and which activities instantiate
-now but not in the package data (``gained``) or the other way round (``lost``); ``--check`` only
+now but not in the package data (``gained``) or the other way round (``lost``), and the activities whose
+goal no state meets (``unsatisfiable``); ``--check`` only
 prints, writing nothing.
 """
 
@@ -47,6 +50,7 @@ def build_task_data(names: list[str] | None = None, progress: bool = False) -> d
             "rearrangement_goal": is_rearrangement_goal(d),
             "goal_predicates": sorted(d.goal_predicates),
             "instantiable": False,
+            "satisfiable": None,
             "reason": "no suitable scene" if not scenes else "",
             "unsupported_init": [],
         }
@@ -59,20 +63,21 @@ def build_task_data(names: list[str] | None = None, progress: bool = False) -> d
             try:
                 if scene is not None:
                     inst = instantiate_in_scene(d, scene, 0)
-                    GoalChecker(inst)  # a task counts only when its goal can be scored too
+                    goals = GoalChecker(inst)  # a task counts only when its goal can be scored too
                     entry["instantiable"] = True
+                    entry["satisfiable"] = goals.satisfiable
                     entry["unsupported_init"] = inst.unsupported_literals
             except UserError as e:
                 entry["reason"] = str(e)
         tasks[name] = entry
         if progress and i % 50 == 0:
             print(f"{i} {name}", file=sys.stderr)
-    rearrange = sorted(n for n, e in tasks.items() if e["rearrangement_goal"] and e["instantiable"])
+    rearrange = sorted(n for n, e in tasks.items() if e["rearrangement_goal"] and e["instantiable"] and e["satisfiable"])
     return {
         "version": TASK_DATA_VERSION,
         "how": "scenes: bddl knowledge-base matching of inroom requirements on combined_room_object_list.json; "
         "instantiable: more_agent.sim.instantiate in the first suitable scene, seed 0, and its goal has "
-        "a bddl ground option",
+        "a bddl ground option; satisfiable: some state meets the goal (more_agent.sim.satisfiable)",
         "sets": {"more-paper": sorted(paper_tasks()), "behavior-rearrange": rearrange},
         "tasks": tasks,
     }
@@ -90,7 +95,8 @@ def main(argv: list[str] | None = None) -> None:
         args.out.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
     now = {n for n, e in data["tasks"].items() if e["instantiable"]}
     was = {n for n, e in before.items() if e["instantiable"]}
-    print(json.dumps({"tasks": len(data["tasks"]), "instantiable": len(now),
+    unsatisfiable = sorted(n for n, e in data["tasks"].items() if e["satisfiable"] is False)
+    print(json.dumps({"tasks": len(data["tasks"]), "instantiable": len(now), "unsatisfiable": unsatisfiable,
                       "behavior-rearrange": len(data["sets"]["behavior-rearrange"]),
                       "package_data_instantiable": len(was), "gained": sorted(now - was), "lost": sorted(was - now),
                       "out": None if args.check else str(args.out)}))

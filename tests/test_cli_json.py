@@ -26,9 +26,10 @@ def _json(args: list[str]) -> object:
 def test_tasks_list_json_has_the_documented_keys() -> None:
     rows = _json(["tasks", "list", "--set", "more-paper"])
     assert len(rows) == 55
-    assert set(rows[0]) == {"task", "n_objects", "n_goal_literals", "instantiable", "scenes"}
+    assert set(rows[0]) == {"task", "n_objects", "n_goal_literals", "instantiable", "satisfiable", "scenes"}
     row = next(r for r in rows if r["task"] == "putting_shopping_away")
-    assert row["instantiable"] is True and row["n_goal_literals"] > 0 and row["scenes"]
+    assert row["instantiable"] is True and row["satisfiable"] is True and row["n_goal_literals"] > 0 and row["scenes"]
+    assert [r["task"] for r in rows if r["satisfiable"] is False] == ["stacking_wood"]
     assert len(_json(["tasks", "list"])) == 1016
 
 
@@ -37,7 +38,8 @@ def test_tasks_show_json_names_the_instance() -> None:
     assert set(out) == {"task", "suitable_scenes", "episode_scenes", "seed", "goal", "instance"}
     assert any(g.startswith("(inside ?pack__of__ground_beef.n.01_1") for g in out["goal"])
     inst = out["instance"]
-    assert set(inst) == {"scene", "description", "objects", "unsupported_literals"}
+    assert set(inst) == {"scene", "description", "objects", "unsupported_literals", "satisfiable"}
+    assert inst["satisfiable"] is True
     assert inst["scene"] == out["episode_scenes"][0]
     fridge = next(o for o in inst["objects"] if o["scope"].startswith("electric_refrigerator"))
     assert set(fridge) == {"scope", "object", "label", "category", "relation", "parent", "room"}

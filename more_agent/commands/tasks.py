@@ -29,7 +29,8 @@ def list_(
     set_: Annotated[str | None, typer.Option("--set", help="Task set: 'more-paper' or 'behavior-rearrange'.")] = None,
     as_json: JsonOption = False,
 ) -> None:
-    """List tasks (all 1016 activities, or one task set) with objects, goal literals, status and scenes."""
+    """List tasks (all 1016 activities, or one task set) with objects, goal literals, status and scenes;
+    'satisfiable: no' marks a goal no state meets (docs/tasks.md)."""
     from more_agent.sim.tasks import task_data, task_set
 
     data = task_data()["tasks"]
@@ -42,6 +43,7 @@ def list_(
                     "n_objects": data[name]["n_objects"],
                     "n_goal_literals": data[name]["n_goal_literals"],
                     "instantiable": data[name]["instantiable"],
+                    "satisfiable": data[name]["satisfiable"],
                     "scenes": data[name]["scenes"],
                 }
                 for name in names
@@ -53,12 +55,12 @@ def list_(
         e = data[name]
         scenes = e["scenes"]
         shown = ", ".join(scenes[:3]) + (f" (+{len(scenes) - 3})" if len(scenes) > 3 else "")
-        rows.append(
-            [name, str(e["n_objects"]), str(e["n_goal_literals"]), "yes" if e["instantiable"] else "no", shown or "-"]
-        )
+        met = {True: "yes", False: "no", None: "-"}[e["satisfiable"]]
+        instantiable = "yes" if e["instantiable"] else "no"
+        rows.append([name, str(e["n_objects"]), str(e["n_goal_literals"]), instantiable, met, shown or "-"])
     print_columns(
         f"{len(names)} tasks" + (f" in {set_}" if set_ else ""),
-        ["task", "objects", "goal literals", "instantiable", "scenes"],
+        ["task", "objects", "goal literals", "instantiable", "satisfiable", "scenes"],
         rows,
     )
 
@@ -130,7 +132,9 @@ def _print_definition(definition: TaskDefinition) -> None:
 
 
 def _print_instance(task: str, scene: str | None, seed: int) -> None:
-    """The task instantiated: its scene, description, and where each scope's object is."""
+    """The task instantiated: its scene, description, whether any state meets its goal, and where each
+    scope's object is."""
+    from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
     inst = instantiate(task, scene, seed)
@@ -138,6 +142,8 @@ def _print_instance(task: str, scene: str | None, seed: int) -> None:
         f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False, markup=False
     )
     console.print(f"description: {inst.description}", highlight=False, markup=False)
+    if not GoalChecker(inst).satisfiable:
+        console.print(_UNSATISFIABLE, style="yellow", highlight=False, markup=False)
     table = Table(title="objects")
     for col in ("scope", "world object", "label", "category", "where"):
         table.add_column(col)
@@ -154,6 +160,7 @@ def _print_instance(task: str, scene: str | None, seed: int) -> None:
 
 def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
     """What ``tasks show --json`` prints (keys in docs/cli-json.md)."""
+    from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
     from more_agent.sim.tasks import (
         check_scene_suits,
@@ -196,5 +203,10 @@ def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
             "description": inst.description,
             "objects": objects,
             "unsupported_literals": list(inst.unsupported_literals),
+            "satisfiable": GoalChecker(inst).satisfiable,
         }
     return out
+
+
+_UNSATISFIABLE = "no state meets this goal: every episode of it fails, whatever the robot does (docs/tasks.md)"
+"""What ``tasks show`` says of a goal that is unsatisfiable (``GoalChecker.satisfiable``)."""

@@ -21,7 +21,8 @@ from bddl.logic_base import AtomicFormula
 
 def satisfiable(goal: Sequence[Any]) -> bool:
     """Whether some truth assignment of the atoms makes every head of the compiled ``goal`` true (bddl's
-    ``get_goal_conditions`` output). A solver that stops without an answer counts as satisfiable."""
+    ``get_goal_conditions`` output). A solver that stops without an answer (``TIME_LIMIT_S``) counts as
+    satisfiable: only a proof of no solution says False."""
     from scipy.optimize import Bounds, LinearConstraint, milp
     from scipy.sparse import coo_array
 
@@ -37,9 +38,13 @@ def satisfiable(goal: Sequence[Any]) -> bool:
         integrality=np.ones(program.n_vars),
         bounds=Bounds(0, 1),
         constraints=LinearConstraint(matrix, low, high),
+        options={"time_limit": TIME_LIMIT_S},
     )
     return bool(result.status != _INFEASIBLE)
 
+
+TIME_LIMIT_S = 10.0
+"""The solver's limit per goal; the largest goal of bddl's activities takes well under a second."""
 
 _INFEASIBLE = 2
 """scipy's ``milp`` status for a program without a solution."""

@@ -34,6 +34,16 @@ def test_show_task_with_a_seed_places_it_in_a_scene() -> None:
     assert result.exit_code == 0, result.output
     assert "instantiated in" in result.output and "fridge A" in result.output
     assert "(inside ?pack__of__ground_beef.n.01_1" in result.output
+    assert "no state meets this goal" not in result.output
+
+
+def test_show_says_when_no_state_meets_the_goal() -> None:
+    result = runner.invoke(app, ["tasks", "show", "stacking_wood", "--seed", "0"])
+    assert result.exit_code == 0, result.output
+    assert "no state meets this goal" in result.output and "instantiated in" in result.output
+    listed = runner.invoke(app, ["tasks", "list", "--set", "more-paper"])
+    row = next(line for line in listed.output.splitlines() if line.startswith("stacking_wood"))
+    assert row.split()[3:5] == ["yes", "no"]  # instantiable, and no state meets its goal
 
 
 def test_show_unknown_task_exits_2_with_closest_names() -> None:
