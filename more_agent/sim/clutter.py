@@ -203,7 +203,7 @@ class _RoomPlacer:
         p = self.area[fits] / self.area[fits].sum()
         for i in self.rng.choice(fits, size=len(fits), replace=False, p=p):
             support, rel = self.supports[int(i)]
-            if self.world.place_if_room(obj.name, support.name, rel):
+            if self.world.place_if_room(obj.name, support.name, rel, rng=self.rng):
                 return True
             self.full.add((int(i), obj.category))
         return False

@@ -12,8 +12,9 @@ Steps (all deterministic for a given task, scene and seed):
    ('apple.n.01_1' -> 'apple_1').
 4. Placement literals run supports first (topological order): ``ontop``/``inside`` rest the item on
    / in its support (on a floor: at a free spot sampled against furniture, walls, doors and other
-   floor items; elsewhere at a free slot that no other box reaches into, ``sim.packing.free_slot``:
-   not inside a TV standing on the same table, on the highest level within reach of a tall shelf);
+   floor items; elsewhere at a free slot that no other box reaches into, drawn with the seed as
+   OmniGibson samples a pose over the support, ``sim.packing.free_slot``: not inside a TV standing on
+   the same table, on the highest level within reach of a tall shelf);
    ``under`` puts it on the floor at the support's footprint centre; ``nextto`` /
    ``touching`` on the floor beside the other object, or on the same support when that object is
    not on a floor. Openable containers that receive items are closed unless an ``open`` literal
@@ -442,12 +443,13 @@ class _Builder:
         fails this scene). An item with no slot as it comes is turned a quarter and tried again when
         its turned footprint lies within the surface (the slot grid follows the item's footprint:
         a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
-        if self.world.place_if_room(name, support, relation, stack=True):  # type: ignore[arg-type]  # ontop / inside
+        if self.world.place_if_room(name, support, relation, stack=True, rng=self.rng):  # type: ignore[arg-type]  # ontop / inside
             return
         obj = self.world.objects[name]
         lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
         obj.size = obj.size[[1, 0, 2]]
-        if not (np.all(obj.size[:2] <= hi - lo) and self.world.place_if_room(name, support, relation, stack=True)):  # type: ignore[arg-type]
+        turned = np.all(obj.size[:2] <= hi - lo)
+        if not (turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.rng)):  # type: ignore[arg-type]
             obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 

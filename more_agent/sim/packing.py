@@ -76,8 +76,9 @@ def fit(
     others: Sequence[WorldObject],
     *,
     stack: bool = False,
+    rng: np.random.Generator | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """(centre, size) of ``obj`` at its first free slot (``free_slot``) among ``others`` in its own shape
+    """(centre, size) of ``obj`` at a free slot (``free_slot``; ``rng`` draws it) among ``others`` in its own shape
     or, for cloth, folded in half up to ``MAX_FOLDS`` times, as a garment goes into a washer or a carton;
     None when no shape fits. A fold halves the longer side and lays the garment flat, 2^folds
     layers of cloth thick at most (a garment model's box is a draped heap, mostly air)."""
@@ -89,7 +90,7 @@ def fit(
             size[2] = min(size[2], CLOTH_LAYER_M * 2**fold)
         if fold < folds and np.any(size[:2] + SLOT_GAP_M > hi - lo):
             continue  # cloth folds rather than overhang
-        slot = free_slot(obj, support, relation, others, stack=stack, size=size)
+        slot = free_slot(obj, support, relation, others, stack=stack, size=size, rng=rng)
         if slot is not None:
             return slot, size
     return None
@@ -103,9 +104,11 @@ def free_slot(
     *,
     stack: bool = False,
     size: np.ndarray | None = None,
+    rng: np.random.Generator | None = None,
 ) -> np.ndarray | None:
-    """Centre of the first slot on the support, in reading order, where the item's box (of ``size``,
-    default its own) meets none of ``others`` standing in the space it would take (``in_space``); with
+    """Centre of a slot on the support where the item's box (of ``size``, default its own) meets none of
+    ``others`` standing in the space it would take (``in_space``): the first in reading order, or one
+    ``rng`` draws among the free ones, as OmniGibson samples a pose over a support at random; with
     ``stack``, when the surface is full, at a slot flush with its far edges (``_slots``), else on the
     next layer up (on the highest item in the way, whichever support it rests on; in a closed-lid
     container only while it fits under the lid). An item wider than the surface overhangs it, centred.
@@ -123,7 +126,8 @@ def free_slot(
             overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
             free = slots[~overlap]
         if len(free):
-            return np.array([free[0, 0], free[0, 1], z + size[2] / 2])
+            x, y = free[0 if rng is None else int(rng.integers(len(free)))]
+            return np.array([x, y, z + size[2] / 2])
         layer = [o.top for o in there if o.kind == "item"]
         lidded = relation == "inside" and support.openable
         if not stack or not layer or (lidded and max(layer) + size[2] > support.top):

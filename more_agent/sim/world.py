@@ -196,10 +196,13 @@ class World:
         obj, support = self.objects[name], self.objects[parent]
         self._rest(obj, support, relation, *packing.magic_fit(obj, support, relation, self._in_the_way(obj, support)))
 
-    def place_if_room(self, name: str, parent: str, relation: Relation, *, stack: bool = False) -> bool:
-        """Like ``place``, but only where it fits (``packing.fit``); False (nothing changed) when it does not."""
+    def place_if_room(
+        self, name: str, parent: str, relation: Relation, *, stack: bool = False, rng: np.random.Generator | None = None
+    ) -> bool:
+        """Like ``place``, but only where it fits (``packing.fit``; at a free slot ``rng`` draws, when given);
+        False (nothing changed) when it does not."""
         obj, support = self.objects[name], self.objects[parent]
-        fitted = packing.fit(obj, support, relation, self._in_the_way(obj, support), stack=stack)
+        fitted = packing.fit(obj, support, relation, self._in_the_way(obj, support), stack=stack, rng=rng)
         if fitted is None:
             return False
         self._rest(obj, support, relation, *fitted)

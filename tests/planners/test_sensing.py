@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from more_agent.planners.policies import Embodiment
@@ -12,7 +13,10 @@ from more_agent.planners.policies.embodiment import PolicyConfig
 from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import instantiate_in_scene
+from more_agent.sim.motion import clearance, obstacle_boxes
+from more_agent.sim.navgrid import DEFAULT_NAV
 from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -35,6 +39,8 @@ def test_the_angle_stays_below_the_cameras_field_of_view() -> None:
 @pytest.mark.parametrize("distance_m", [0.3, 0.6])
 def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_m: float) -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
+    robot = inst.world.robot
+    inst.world.set_robot_pose(robot.x, robot.y, _clear_heading(inst.world, 1.5))
     body = Embodiment(SimRobot(inst.world, labels=inst.labels), config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
     body.sense()  # the frame where the robot stands
     frames: list[tuple[float, float]] = []
@@ -47,3 +53,14 @@ def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_
     assert frames[-1] == body.xy == pytest.approx(goal)  # the arrival is always sensed
     assert all(g <= distance_m + 1e-6 for g in gaps), gaps  # never further apart than the cadence
     assert len(frames) == math.floor(1.5 / distance_m + 1e-6) + 1  # one per distance on the way, one at arrival
+
+
+def _clear_heading(world: World, length_m: float) -> float:
+    """A heading from the robot's position along which ``length_m`` of floor lie clear: the task-room start
+    may face furniture, and a turn on the way would add frames of its own."""
+    boxes, robot = obstacle_boxes(world), world.robot
+    for yaw in np.linspace(0.0, 2 * math.pi, 16, endpoint=False):
+        ahead = [(robot.x + d * math.cos(yaw), robot.y + d * math.sin(yaw)) for d in np.arange(0.0, length_m + 0.2, 0.05)]
+        if all(clearance(boxes, x, y) > DEFAULT_NAV.robot_radius_m for x, y in ahead):
+            return float(yaw)
+    raise AssertionError("no clear heading from the start")

@@ -91,3 +91,30 @@ def test_activities_lost_to_the_strict_slots_instantiate_again(task: str) -> Non
     GoalChecker(inst)  # counted only when the goal can be scored
     items = [n for n in inst.scope.values() if n in inst.world.objects and inst.world.objects[n].kind == "item"]
     assert {n: _overlaps(inst.world, n) for n in items if _overlaps(inst.world, n)} == {}
+
+
+def test_an_item_rests_at_a_free_slot_the_seed_draws_not_the_first_in_reading_order() -> None:
+    """OmniGibson samples an ontop pose over the support at random: with a generator, every free slot can come,
+    the same one for the same seed; without, the first in reading order (a placing action's)."""
+    spots = []
+    for seed in range(8):
+        world = World(scene=load_scene(TINY))
+        table = _add(world, "table_0", "breakfast_table", "furniture", (0.0, 0.0, 0.35), (1.6, 0.9, 0.7))
+        _add(world, "apple_0", "apple", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.08))
+        _add(world, "cup_0", "mug", "item", (5.0, 5.0, 0.0), (0.1, 0.1, 0.1))
+        assert world.place_if_room("cup_0", table.name, "ontop", rng=np.random.default_rng(seed))
+        assert world.place_if_room("apple_0", table.name, "ontop", rng=np.random.default_rng(seed + 100))
+        assert _overlaps(world, "apple_0") == [] and world.objects["apple_0"].parent == table.name
+        spots.append(tuple(np.round(world.objects["apple_0"].center, 6)))
+    assert len(set(spots)) >= 6  # not one corner for every seed
+    again = World(scene=load_scene(TINY))
+    table = _add(again, "table_0", "breakfast_table", "furniture", (0.0, 0.0, 0.35), (1.6, 0.9, 0.7))
+    _add(again, "apple_0", "apple", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.08))
+    assert again.place_if_room("apple_0", table.name, "ontop")
+    apple = again.objects["apple_0"]
+    assert np.all(apple.box()[0][:2] <= table.box()[0][:2] + 0.1)  # the near corner, in reading order
+    first = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
+    second = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
+    assert {n: tuple(o.center) for n, o in first.world.objects.items()} == {
+        n: tuple(o.center) for n, o in second.world.objects.items()
+    }  # the same seed, the same world
