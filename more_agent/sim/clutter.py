@@ -134,10 +134,11 @@ def add_distractors(world: World, rng: np.random.Generator, counts: dict[str, di
     rooms = {r.id for r in world.scene.rooms}
     clutter = Clutter()
     serial = 0
+    slots = rng.spawn(1)[0]  # the slots' own stream: drawing them leaves every other draw as it was
     for room, per_category in counts.items():
         if room not in rooms:
             continue
-        placer = _RoomPlacer(world, room, rng)
+        placer = _RoomPlacer(world, room, rng, slots)
         for category in sorted(per_category):
             synsets = catalog.category_synsets(category)
             synset, size = synsets[0] if synsets else None, catalog.category_size(category)
@@ -170,8 +171,8 @@ def add_distractors(world: World, rng: np.random.Generator, counts: dict[str, di
 class _RoomPlacer:
     """Scratch state for placing one room's distractors: its supports and which are full for what."""
 
-    def __init__(self, world: World, room: str, rng: np.random.Generator) -> None:
-        self.world, self.room, self.rng = world, room, rng
+    def __init__(self, world: World, room: str, rng: np.random.Generator, slots: np.random.Generator) -> None:
+        self.world, self.room, self.rng, self.slots = world, room, rng, slots
         self.supports: list[tuple[WorldObject, Relation]] = []
         for obj in world.objects.values():
             if obj.kind != "furniture" or obj.room != room:
@@ -203,7 +204,7 @@ class _RoomPlacer:
         p = self.area[fits] / self.area[fits].sum()
         for i in self.rng.choice(fits, size=len(fits), replace=False, p=p):
             support, rel = self.supports[int(i)]
-            if self.world.place_if_room(obj.name, support.name, rel, rng=self.rng):
+            if self.world.place_if_room(obj.name, support.name, rel, rng=self.slots):
                 return True
             self.full.add((int(i), obj.category))
         return False

@@ -275,6 +275,8 @@ class _Builder:
 
     def __init__(self, definition: TaskDefinition, world: World, rng: np.random.Generator) -> None:
         self.d, self.world, self.rng = definition, world, rng
+        self.slots = rng.spawn(1)[0]
+        """The slots' own stream (``sim.packing.free_slot``): drawing them leaves every other draw as it was."""
         self.scope: dict[str, str] = {}
         self.virtual: set[str] = set()
         self.unsupported: list[str] = []
@@ -443,13 +445,13 @@ class _Builder:
         fails this scene). An item with no slot as it comes is turned a quarter and tried again when
         its turned footprint lies within the surface (the slot grid follows the item's footprint:
         a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
-        if self.world.place_if_room(name, support, relation, stack=True, rng=self.rng):  # type: ignore[arg-type]  # ontop / inside
+        if self.world.place_if_room(name, support, relation, stack=True, rng=self.slots):  # type: ignore[arg-type]  # ontop / inside
             return
         obj = self.world.objects[name]
         lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
         obj.size = obj.size[[1, 0, 2]]
         turned = np.all(obj.size[:2] <= hi - lo)
-        if not (turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.rng)):  # type: ignore[arg-type]
+        if not (turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.slots)):  # type: ignore[arg-type]
             obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 

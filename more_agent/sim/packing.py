@@ -117,8 +117,10 @@ def free_slot(
     lo, hi, z = support_surface(support, relation)
     half = size[:2] / 2 + SLOT_GAP_M / 2
     slots = _slots(lo, hi, half, flush=stack)
+    # where the item may stand: the surface, and beyond it where an item wider than it overhangs
+    span_lo, span_hi = np.minimum(lo, slots.min(axis=0) - half), np.maximum(hi, slots.max(axis=0) + half)
     while True:
-        there = in_space(others, lo, hi, z, size[2])
+        there = in_space(others, span_lo, span_hi, z, size[2])
         free = slots
         if there:
             centers = np.array([o.center[:2] for o in there])
