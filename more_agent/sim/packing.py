@@ -107,8 +107,11 @@ def free_slot(
     rng: np.random.Generator | None = None,
 ) -> np.ndarray | None:
     """Centre of a slot on the support where the item's box (of ``size``, default its own) meets none of
-    ``others`` standing in the space it would take (``in_space``): the first in reading order, or one
-    ``rng`` draws among the free ones, as OmniGibson samples a pose over a support at random; with
+    ``others`` standing in the space it would take (``in_space``): the first in reading order, or, on top
+    of a support, one ``rng`` draws among the free ones, as OmniGibson samples a pose over a support at
+    random. Inside a container the first still: the paper's robot sees all that is inside once it is
+    opened, wherever it lies, and packed densely a container holds what bddl puts in it (random slots
+    left no room for make_baked_pears' wine bottle in its cabinet); with
     ``stack``, when the surface is full, at a slot flush with its far edges (``_slots``), else on the
     next layer up (on the highest item in the way, whichever support it rests on; in a closed-lid
     container only while it fits under the lid). An item wider than the surface overhangs it, centred.
@@ -128,7 +131,7 @@ def free_slot(
             overlap = np.all(np.abs(slots[:, None, :] - centers[None]) < reach[None], axis=2).any(axis=1)
             free = slots[~overlap]
         if len(free):
-            x, y = free[0 if rng is None else int(rng.integers(len(free)))]
+            x, y = free[0 if rng is None or relation == "inside" else int(rng.integers(len(free)))]
             return np.array([x, y, z + size[2] / 2])
         layer = [o.top for o in there if o.kind == "item"]
         lidded = relation == "inside" and support.openable

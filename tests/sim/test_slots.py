@@ -95,7 +95,7 @@ def test_activities_lost_to_the_strict_slots_instantiate_again(task: str) -> Non
 
 def test_an_item_rests_at_a_free_slot_the_seed_draws_not_the_first_in_reading_order() -> None:
     """OmniGibson samples an ontop pose over the support at random: with a generator, every free slot can come,
-    the same one for the same seed; without, the first in reading order (a placing action's)."""
+    the same one for the same seed; without, or inside a container, the first in reading order."""
     spots = []
     for seed in range(8):
         world = World(scene=load_scene(TINY))
@@ -113,6 +113,11 @@ def test_an_item_rests_at_a_free_slot_the_seed_draws_not_the_first_in_reading_or
     assert again.place_if_room("apple_0", table.name, "ontop")
     apple = again.objects["apple_0"]
     assert np.all(apple.box()[0][:2] <= table.box()[0][:2] + 0.1)  # the near corner, in reading order
+    cabinet = _add(again, "cabinet_0", "bottom_cabinet_no_top", "furniture", (3.0, 0.0, 0.3), (0.73, 0.45, 0.6),
+                   openable=True)
+    _add(again, "pear_0", "pear", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.1))
+    assert again.place_if_room("pear_0", cabinet.name, "inside", rng=np.random.default_rng(7))
+    assert np.all(again.objects["pear_0"].box()[0][:2] <= cabinet.box()[0][:2] + 0.1)  # inside: packed from the corner
     first = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
     second = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
     assert {n: tuple(o.center) for n, o in first.world.objects.items()} == {
