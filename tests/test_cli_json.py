@@ -46,6 +46,11 @@ def test_tasks_show_json_names_the_instance() -> None:
     assert fridge["label"] == "fridge A"
 
 
+def test_tasks_show_json_shows_a_goal_bddl_cannot_score() -> None:
+    inst = _json(["tasks", "show", "make_a_bake_sale_stand_stall"])["instance"]  # no ground option for its goal
+    assert inst["objects"] and inst["satisfiable"] is None
+
+
 def test_tasks_show_json_keeps_the_clean_error() -> None:
     result = runner.invoke(app, ["tasks", "show", "putting_shoping_away", "--json"])
     assert result.exit_code == 2 and "putting_shopping_away" in result.output and "Traceback" not in result.output

@@ -18,6 +18,7 @@ from more_agent.commands._common import (
 )
 
 if TYPE_CHECKING:
+    from more_agent.sim.instantiate import TaskInstance
     from more_agent.sim.tasks import TaskDefinition
 
 app = typer.Typer(help="BEHAVIOR-1K activities: list task sets, show one task.", no_args_is_help=True)
@@ -134,7 +135,6 @@ def _print_definition(definition: TaskDefinition) -> None:
 def _print_instance(task: str, scene: str | None, seed: int) -> None:
     """The task instantiated: its scene, description, whether any state meets its goal, and where each
     scope's object is."""
-    from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
 
     inst = instantiate(task, scene, seed)
@@ -142,7 +142,7 @@ def _print_instance(task: str, scene: str | None, seed: int) -> None:
         f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False, markup=False
     )
     console.print(f"description: {inst.description}", highlight=False, markup=False)
-    if not GoalChecker(inst).satisfiable:
+    if _satisfiable(inst) is False:
         console.print(_UNSATISFIABLE, style="yellow", highlight=False, markup=False)
     table = Table(title="objects")
     for col in ("scope", "world object", "label", "category", "where"):
@@ -160,7 +160,6 @@ def _print_instance(task: str, scene: str | None, seed: int) -> None:
 
 def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
     """What ``tasks show --json`` prints (keys in docs/cli-json.md)."""
-    from more_agent.sim.goals import GoalChecker
     from more_agent.sim.instantiate import instantiate
     from more_agent.sim.tasks import (
         check_scene_suits,
@@ -203,9 +202,20 @@ def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
             "description": inst.description,
             "objects": objects,
             "unsupported_literals": list(inst.unsupported_literals),
-            "satisfiable": GoalChecker(inst).satisfiable,
+            "satisfiable": _satisfiable(inst),
         }
     return out
+
+
+def _satisfiable(inst: TaskInstance) -> bool | None:
+    """Whether any state meets the instance's goal (``GoalChecker.satisfiable``); None when bddl cannot
+    score its goal at all (``GoalError``: make_a_bake_sale_stand_stall), which ``tasks show`` still shows."""
+    from more_agent.sim.goals import GoalChecker, GoalError
+
+    try:
+        return GoalChecker(inst).satisfiable
+    except GoalError:
+        return None
 
 
 _UNSATISFIABLE = "no state meets this goal: every episode of it fails, whatever the robot does (docs/tasks.md)"
