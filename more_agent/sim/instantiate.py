@@ -450,8 +450,8 @@ class _Builder:
         obj = self.world.objects[name]
         lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
         obj.size = obj.size[[1, 0, 2]]
-        turned = np.all(obj.size[:2] <= hi - lo)
-        if not (turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.slots)):  # type: ignore[arg-type]
+        fits_turned = np.all(obj.size[:2] <= hi - lo)
+        if not (fits_turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.slots)):  # type: ignore[arg-type]
             obj.size = obj.size[[1, 0, 2]]
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 

@@ -44,7 +44,8 @@ def satisfiable(goal: Sequence[Any]) -> bool:
 
 
 TIME_LIMIT_S = 10.0
-"""The solver's limit per goal; the largest goal of bddl's activities takes well under a second."""
+"""The solver's limit per goal. Over the 939 activities that instantiate, solving takes 2 ms (median) and 25 ms
+at most (stacking_wood's proof; 2026-12-03, scipy imported beforehand)."""
 
 _INFEASIBLE = 2
 """scipy's ``milp`` status for a program without a solution."""

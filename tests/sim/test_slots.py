@@ -93,33 +93,37 @@ def test_activities_lost_to_the_strict_slots_instantiate_again(task: str) -> Non
     assert {n: _overlaps(inst.world, n) for n in items if _overlaps(inst.world, n)} == {}
 
 
+def _table_with_apple() -> World:
+    """A breakfast table on the tiny scene and an apple not yet placed."""
+    world = World(scene=load_scene(TINY))
+    _add(world, "table_0", "breakfast_table", "furniture", (0.0, 0.0, 0.35), (1.6, 0.9, 0.7))
+    _add(world, "apple_0", "apple", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.08))
+    return world
+
+
 def test_an_item_rests_at_a_free_slot_the_seed_draws_not_the_first_in_reading_order() -> None:
     """OmniGibson samples an ontop pose over the support at random: with a generator, every free slot can come,
     the same one for the same seed; without, or inside a container, the first in reading order."""
     spots = []
     for seed in range(8):
-        world = World(scene=load_scene(TINY))
-        table = _add(world, "table_0", "breakfast_table", "furniture", (0.0, 0.0, 0.35), (1.6, 0.9, 0.7))
-        _add(world, "apple_0", "apple", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.08))
+        world = _table_with_apple()
         _add(world, "cup_0", "mug", "item", (5.0, 5.0, 0.0), (0.1, 0.1, 0.1))
-        assert world.place_if_room("cup_0", table.name, "ontop", rng=np.random.default_rng(seed))
-        assert world.place_if_room("apple_0", table.name, "ontop", rng=np.random.default_rng(seed + 100))
-        assert _overlaps(world, "apple_0") == [] and world.objects["apple_0"].parent == table.name
+        assert world.place_if_room("cup_0", "table_0", "ontop", rng=np.random.default_rng(seed))
+        assert world.place_if_room("apple_0", "table_0", "ontop", rng=np.random.default_rng(seed + 100))
+        assert _overlaps(world, "apple_0") == [] and world.objects["apple_0"].parent == "table_0"
         spots.append(tuple(np.round(world.objects["apple_0"].center, 6)))
     assert len(set(spots)) >= 6  # not one corner for every seed
-    again = World(scene=load_scene(TINY))
-    table = _add(again, "table_0", "breakfast_table", "furniture", (0.0, 0.0, 0.35), (1.6, 0.9, 0.7))
-    _add(again, "apple_0", "apple", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.08))
-    assert again.place_if_room("apple_0", table.name, "ontop")
-    apple = again.objects["apple_0"]
+    again = _table_with_apple()
+    assert again.place_if_room("apple_0", "table_0", "ontop")
+    apple, table = again.objects["apple_0"], again.objects["table_0"]
     assert np.all(apple.box()[0][:2] <= table.box()[0][:2] + 0.1)  # the near corner, in reading order
     cabinet = _add(again, "cabinet_0", "bottom_cabinet_no_top", "furniture", (3.0, 0.0, 0.3), (0.73, 0.45, 0.6),
                    openable=True)
     _add(again, "pear_0", "pear", "item", (5.0, 5.0, 0.0), (0.08, 0.08, 0.1))
     assert again.place_if_room("pear_0", cabinet.name, "inside", rng=np.random.default_rng(7))
     assert np.all(again.objects["pear_0"].box()[0][:2] <= cabinet.box()[0][:2] + 0.1)  # inside: packed from the corner
-    first = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
-    second = instantiate_in_scene("putting_shopping_away", load_scene(TINY.parent / "tasks_kitchen_scene.json"), seed=3)
+    kitchen = load_scene(TINY.parent / "tasks_kitchen_scene.json")
+    first, second = (instantiate_in_scene("putting_shopping_away", kitchen, seed=3) for _ in range(2))
     assert {n: tuple(o.center) for n, o in first.world.objects.items()} == {
         n: tuple(o.center) for n, o in second.world.objects.items()
     }  # the same seed, the same world
