@@ -287,6 +287,22 @@ def test_a_robot_its_map_walls_in_retraces_the_exact_way_it_drove_in() -> None:
     assert way_back(DrivenBody(long_way), occupancy, [(-RETRACE_M, 1.0)], 0.5) is None  # type: ignore[arg-type]
 
 
+def test_the_way_back_does_not_drive_again_a_loop_the_way_in_made() -> None:
+    """A way in that went into a nook and came back (a final approach to a counter, then retraced) passes
+    the same spots twice; the world's base may leave such a nook but not re-enter it. The way back cuts
+    the loop: from the spot where the excursion began it goes on backwards, never into the nook."""
+    grid = np.full((60, 30), FREE)  # [ix, iy], 0.1 m cells
+    grid[30:33, :] = OCCUPIED  # items across the way in, mapped once the base had driven over them
+    occupancy = OccupancyMap(grid=grid, origin_xy=(0.0, 0.0), resolution_m=0.1)
+    way_in = [(1.0 + 0.075 * k, 1.03) for k in range(60)]
+    nook = [(way_in[-1][0], 1.03 + 0.075 * k) for k in range(1, 11)]
+    body = DrivenBody([*way_in, *nook, *nook[-2::-1], way_in[-1], (way_in[-1][0] + 0.075, 1.03)])
+    way = way_back(body, occupancy, [(0.5, 1.0)], 0.5)  # type: ignore[arg-type]
+    assert way is not None and way[-1][0] < 3.0
+    assert all(y < 1.04 for _, y in way)  # never into the nook
+    assert way[1:] == way_in[::-1][: len(way) - 1]  # then the positions held on the way in, backwards
+
+
 def test_a_gap_the_base_fits_through_is_not_closed_by_the_planning_margin() -> None:
     """A doorway 0.45 m wide on the map: the base (0.2 m radius) fits, the full clearance (0.25 m) does
     not. Paths keep the full clearance where they can and fall back to the base's own radius only when

@@ -14,6 +14,7 @@ Planners run a decided skill with :func:`run_skill`, which looks the skill up in
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Callable, Iterator, Sequence
 
@@ -111,18 +112,60 @@ def way_back(
     return None
 
 
+SAME_SPOT_M = 0.01
+"""Positions of the robot's way this close are one spot (a way retraced holds the same positions again)."""
+
+
 def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
-    """The robot's way in, walked backwards from where it stands through the exact positions it held: each
-    longer prefix in turn, up to ``max_m`` long."""
-    way, length = [body.xy], 0.0
-    for xy in reversed(body.trajectory):
-        step = math.dist(xy, way[-1])
-        length += step
-        if length > max_m:
-            return
-        if step > 1e-6:
-            way.append(xy)
-            yield way
+    """Ways back over the positions the robot held, to each earlier one in turn (latest first) that lies
+    within ``max_m`` of where it stands: the shortest, along segments it drove, through spots it held.
+
+    A way in that passes a spot twice is a loop the way back need not drive again. A final approach can
+    leave the base in a nook the world's base may leave but not re-enter (a move that ends within its
+    clearance must gain clearance); walked backwards step by step, a way in that went there and came back
+    (to grasp at a counter, then retraced) would lead into the nook again (putting_out_condiments seed 0)."""
+    spots, edges, order = _spot_graph([*body.trajectory, body.xy])
+    here = order[0]
+    dist, previous = {here: 0.0}, {here: here}
+    queue = [(0.0, here)]
+    while queue:
+        d, node = heapq.heappop(queue)
+        if d > dist[node]:
+            continue
+        for other, length in edges[node].items():
+            if d + length < dist.get(other, math.inf) and d + length <= max_m:
+                dist[other], previous[other] = d + length, node
+                heapq.heappush(queue, (d + length, other))
+    for node in order[1:]:
+        if node in dist:
+            way = [node]
+            while way[-1] != here:
+                way.append(previous[way[-1]])
+            yield [spots[k] for k in reversed(way)]
+
+
+def _spot_graph(positions: Sequence[XY]) -> tuple[list[XY], list[dict[int, float]], list[int]]:
+    """Positions merged into spots (``SAME_SPOT_M``): each spot's position (its latest), the length of
+    every segment driven between two spots, and the spots latest first, each once."""
+    spots: list[XY] = []
+    by_cell: dict[tuple[int, int], list[int]] = {}
+    edges: list[dict[int, float]] = []
+    order: list[int] = []
+    last: int | None = None
+    for xy in reversed(positions):
+        i, j = math.floor(xy[0] / SAME_SPOT_M), math.floor(xy[1] / SAME_SPOT_M)
+        near = (k for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1) for k in by_cell.get((a, b), ()))
+        node = next((k for k in near if math.dist(spots[k], xy) <= SAME_SPOT_M), None)
+        if node is None:
+            node = len(spots)
+            spots.append(xy)
+            edges.append({})
+            by_cell.setdefault((i, j), []).append(node)
+            order.append(node)
+        if last is not None and last != node:
+            edges[last][node] = edges[node][last] = math.dist(spots[last], spots[node])
+        last = node
+    return spots, edges, order
 
 
 def plan_path(
