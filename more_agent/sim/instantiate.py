@@ -490,7 +490,7 @@ class _Builder:
     def place_robot(self) -> None:
         floor = self._default_floor()
         room = self.world.objects[floor].room
-        xy = free_floor_spot(self.world, room, np.full(2, ROBOT_CLEARANCE_M), self.rng)
+        xy = free_floor_spot(self.world, room, np.full(2, ROBOT_CLEARANCE_M), self.rng, keep_passages=False)
         if xy is None:
             raise InstantiationError(f"no free spot for the robot in {room}")
         self.world.set_robot_pose(xy[0], xy[1], float(self.rng.uniform(-np.pi, np.pi)))

@@ -3,7 +3,10 @@
 ``random_start`` draws a pose uniformly over the reachable free space of the whole scene: the cells
 of the ground-truth navigation grid (every door counted open, as the robot can open them) that lie
 in a connected component holding a base pose from which the magic actions reach some task object,
-indoors or outdoors; the position is uniform within the drawn cell and the heading uniform.
+indoors or outdoors; the position is uniform within the drawn cell and the heading uniform. Floor
+items count as obstacles there (``clear_of_floor_items``): the world's base drives over them, but the
+robot's map shows them, and a start among them (putting_away_tools seed 1: in a corner behind a
+0.5 m box on the floor) left the robot sealed in on its own map from its first step.
 ``start_facts`` measures the start against the task: the rooms holding task objects, and the
 shortest path on that grid from the start to the nearest such pose.
 """
@@ -19,6 +22,7 @@ from scipy import ndimage
 
 from more_agent.errors import UserError
 from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
+from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M
 from more_agent.sim.navgrid import NavGrid, free_cells, nav_grid, shortest_path
 from more_agent.sim.world import World
 
@@ -75,10 +79,9 @@ def random_start(
     ``MIN_ROOM_FREE_M2`` of such free space, then the position uniformly within it.
     """
     grid = nav_grid(world, all_doors_open=True)
-    components, _ = ndimage.label(grid.free, structure=np.ones((3, 3)))
-    goals = approach_cells(world, grid, targets)
-    keep = np.unique([components[c] for c in goals]) if targets else np.unique(components)
-    free = np.isin(components, keep[keep > 0])
+    free = _reachable(grid.free & clear_of_floor_items(world, grid), approach_cells(world, grid, targets), targets)
+    if not free.any():  # floor items close every way to the task: the furniture's free space alone
+        free = _reachable(grid.free, approach_cells(world, grid, targets), targets)
     if by_room:
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
         xy = grid.xy_of(np.stack(list(np.indices(grid.shape)), axis=-1))
@@ -96,6 +99,27 @@ def random_start(
     cx, cy = grid.centre(cells[rng.integers(len(cells))])
     jitter = rng.uniform(-0.5, 0.5, size=2) * grid.resolution_m
     return float(cx + jitter[0]), float(cy + jitter[1]), float(rng.uniform(-np.pi, np.pi))
+
+
+def _reachable(free: np.ndarray, goals: list[tuple[int, int]], targets: list[str]) -> np.ndarray:
+    """The cells of ``free`` connected to one of ``goals`` (all of them when there is no target)."""
+    components, _ = ndimage.label(free, structure=np.ones((3, 3)))
+    keep = np.unique([components[c] for c in goals]) if targets else np.unique(components)
+    return np.isin(components, keep[keep > 0])
+
+
+def clear_of_floor_items(world: World, grid: NavGrid) -> np.ndarray:
+    """Cells of ``grid`` farther than ``PASSAGE_CLEARANCE_M`` from every item on a floor (the clearance a
+    floor item leaves along a passage, ``floorspots``)."""
+    items = np.zeros(grid.shape, dtype=bool)
+    for obj in world.objects.values():
+        if obj.kind == "item" and obj.parent is not None and world.objects[obj.parent].kind == "floor":
+            x0, y0, x1, y1 = obj.footprint()
+            (i0, j0), (i1, j1) = grid.cell_at(x0, y0), grid.cell_at(x1, y1)
+            items[i0 : i1 + 1, j0 : j1 + 1] = True
+    if not items.any():
+        return np.ones(grid.shape, dtype=bool)
+    return ndimage.distance_transform_edt(~items) * grid.resolution_m > PASSAGE_CLEARANCE_M
 
 
 def start_to_task_m(world: World, targets: list[str]) -> float | None:

@@ -19,6 +19,7 @@ from more_agent.sim.clutter import (
     is_surface,
     room_item_counts,
 )
+from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M
 from more_agent.sim.instantiate import instantiate, instantiate_in_scene
 from more_agent.sim.navgrid import nav_grid, shortest_path
 from more_agent.sim.render import Renderer
@@ -26,7 +27,7 @@ from more_agent.sim.scene import load_scene, save_scene
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.start import random_start
 from more_agent.sim.tasks import EXCLUDED_SCENES, check_scene_suits, draw_scenes, episode_scenes, suitable_scenes
-from more_agent.sim.world import World
+from more_agent.sim.world import World, WorldObject
 
 KITCHEN = Path(__file__).parent.parent / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -65,6 +66,25 @@ def test_random_start_is_reachable_seeded_and_measured() -> None:
         assert facts.task_rooms == ["kitchen_0"]
         assert facts.start_to_task_m is not None and facts.start_to_task_m >= 0
     assert rooms == {"kitchen_0", "corridor_0"}  # both rooms get drawn
+
+
+def test_the_robot_never_starts_among_floor_items_or_behind_a_row_of_them() -> None:
+    """The world's base drives over floor items, the robot's map does not: a start is drawn clear of them
+    (``PASSAGE_CLEARANCE_M``) and connected to the task on a grid where they block, so a row of boxes across
+    the kitchen leaves the strip behind it (no task object there) out of the draw, where starts landed before."""
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    world, rng = inst.world, np.random.default_rng(0)
+    targets = [n for n in inst.scope.values() if n in world.objects and world.get(n).kind != "floor"]
+    assert any(random_start(world, targets, rng)[0] > 4.7 for _ in range(300))  # type: ignore[index]
+    for k in range(9):  # boxes 0.5 m long across the kitchen (x 4.5-4.7), from its wall to a counter
+        world.add(
+            WorldObject(
+                name=f"box_{k}", category="carton", kind="item", center=np.zeros(3), size=np.array([0.2, 0.5, 0.4])
+            )
+        )
+        world.place_on_floor_at(f"box_{k}", "floor_kitchen_0", (4.6, 0.25 + 0.5 * k))
+    starts = [random_start(world, targets, rng) for _ in range(300)]
+    assert all(s is not None and s[0] < 4.5 - PASSAGE_CLEARANCE_M + 0.075 for s in starts)  # uniform within a cell
 
 
 @pytest.mark.slow

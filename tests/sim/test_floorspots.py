@@ -1,0 +1,64 @@
+"""Floor spots for items: they leave every passage around them open to the robot's base."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M, free_floor_spot, keeps_passages
+from more_agent.sim.scene import load_scene
+from more_agent.sim.world import World, WorldObject
+
+TINY = Path(__file__).parent.parent / "fixtures" / "tiny_scene.json"
+
+ITEM = np.array([0.15, 0.15])
+"""Half extents of a tray-sized floor item."""
+
+
+def _corridor(width_m: float) -> np.ndarray:
+    """Two walls 4 m long along x, ``width_m`` apart (the corridor's floor is 0 <= y <= width)."""
+    return np.array([[0.0, -0.1, 4.0, 0.0], [0.0, width_m, 4.0, width_m + 0.1]])
+
+
+def test_an_item_that_would_narrow_a_corridor_below_the_bases_passage_is_refused() -> None:
+    """In a corridor 0.95 m wide, a tray against a wall leaves 0.65 m, less than the base's passage
+    (2 * PASSAGE_CLEARANCE_M); in one 1.2 m wide it leaves 0.9 m, and in an open room any spot keeps
+    the way round it. A corridor already too narrow for the base has no passage an item could close."""
+    assert 0.65 < 2 * PASSAGE_CLEARANCE_M < 0.9
+    assert not keeps_passages(_corridor(0.95), np.array([2.0, 0.15]), ITEM)
+    assert not keeps_passages(_corridor(0.95), np.array([2.0, 0.5]), ITEM)
+    assert keeps_passages(_corridor(1.2), np.array([2.0, 0.15]), ITEM)
+    assert keeps_passages(np.zeros((0, 4)), np.array([2.0, 0.5]), ITEM)
+    assert keeps_passages(_corridor(0.6), np.array([2.0, 0.3]), ITEM)
+
+
+def test_items_may_line_a_wall_but_not_close_the_gap_between_two_of_them() -> None:
+    """Two trays against the same wall of a 1.2 m corridor, side by side, keep it open; a third across
+    from them, against the other wall, would leave 0.6 m between the rows and is refused, and so would
+    one beside the row that reaches out into the corridor."""
+    row = np.vstack([_corridor(1.2), [[1.7, 0.0, 2.0, 0.3], [2.0, 0.0, 2.3, 0.3]]])
+    assert keeps_passages(row, np.array([2.45, 0.15]), ITEM)
+    assert not keeps_passages(row, np.array([2.0, 1.05]), ITEM)
+    assert not keeps_passages(row, np.array([2.45, 0.5]), ITEM)
+
+
+def test_a_floor_spot_for_an_item_never_closes_a_passage_but_the_robot_may_stand_there() -> None:
+    """A counter in the tiny kitchen leaves a passage 0.95 m wide by its south wall, open at both ends:
+    no spot in it keeps the passage open for a tray, so none is drawn there (a dead end may fill up); the
+    robot's own start spot is not an item."""
+    world = World(scene=load_scene(TINY))
+    world.add(
+        WorldObject(
+            name="counter_9",
+            category="countertop",
+            kind="furniture",
+            center=np.array([2.0, 1.5, 0.45]),
+            size=np.array([2.8, 1.0, 0.9]),
+        )
+    )
+    passage = (1.5, 0.05, 2.5, 1.0)
+    rng = np.random.default_rng(0)
+    assert free_floor_spot(world, "kitchen_0", ITEM, rng, bounds=passage) is None
+    spot = free_floor_spot(world, "kitchen_0", ITEM, rng, bounds=passage, keep_passages=False)
+    assert spot is not None and 0.05 < spot[1] < 1.0
