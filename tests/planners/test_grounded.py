@@ -86,8 +86,10 @@ class BlindGoals(GoalChecker):
 
 
 def fresh_kitchen() -> TaskInstance:
-    """The kitchen task in a world no other test has acted in."""
-    return instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    """The kitchen task in a world no other test has acted in, the robot where door A and the fridge are in view."""
+    kitchen = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0)
+    kitchen.world.set_robot_pose(1.0, 2.9, kitchen.world.robot.yaw)
+    return kitchen
 
 
 def planner_in(kitchen: TaskInstance) -> GroundedPlanner:

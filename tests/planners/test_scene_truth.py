@@ -151,6 +151,7 @@ def test_contents_travel_with_the_carried_container_and_an_opened_door_stays_ope
     put down. The door the robot opened stays in the text, open, even when no frame shows it."""
     inst = instantiate_in_scene("store_produce", load_scene(TINY), seed=0, distractors=False)
     world, labels = inst.world, inst.labels
+    world.set_robot_pose(1.85, 1.48, world.robot.yaw)  # in view of the door, and of the table once it is open
     body = Embodiment(SimRobot(world, labels=labels))
     body.look_around()
     bag = labels.label("sack_1")
