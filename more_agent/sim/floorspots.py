@@ -5,7 +5,7 @@ furniture, door opening (kept clear by ``DOOR_KEEPOUT_M``) or item already on a 
 item, leaves every passage around it open to the robot's base (``keeps_passages``): the world's base
 drives over floor items, but the robot's map (like a real one's) shows them as obstacles, and a room
 strewn with dishes whose gaps the base cannot pass sealed a restaurant kitchen on the map
-(putting_out_condiments seed 0), which the paper's scenes, their dishes on shelves, never do.
+(putting_out_condiments seed 0), where the paper's scenes keep their dishes on shelves.
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
     for obj in world.objects.values():
         if obj.name == exclude or obj.kind == "floor":
             continue
-        if obj.kind == "item" and not (obj.parent and world.objects[obj.parent].kind == "floor"):
+        if obj.kind == "item" and not world.on_floor(obj):
             continue
         x0, y0, x1, y1 = obj.footprint()
         pad = DOOR_KEEPOUT_M if obj.kind == "door" else 0.0
@@ -136,7 +136,6 @@ def _passage_obstacles(world: World, exclude: str | None) -> np.ndarray:
     for obj in world.objects.values():
         if obj.name == exclude or obj.kind in ("floor", "door"):
             continue
-        on_floor = obj.kind == "item" and obj.parent is not None and world.objects[obj.parent].kind == "floor"
-        if on_floor or (obj.kind == "furniture" and obj.bottom < DEFAULT_NAV.obstacle_max_bottom_m):
+        if world.on_floor(obj) or (obj.kind == "furniture" and obj.bottom < DEFAULT_NAV.obstacle_max_bottom_m):
             rows.append(obj.footprint())
     return np.asarray(rows, dtype=float).reshape(-1, 4)

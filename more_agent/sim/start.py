@@ -79,9 +79,10 @@ def random_start(
     ``MIN_ROOM_FREE_M2`` of such free space, then the position uniformly within it.
     """
     grid = nav_grid(world, all_doors_open=True)
-    free = _reachable(grid.free & clear_of_floor_items(world, grid), approach_cells(world, grid, targets), targets)
+    goals = approach_cells(world, grid, targets)
+    free = _reachable(grid.free & clear_of_floor_items(world, grid), goals, targets)
     if not free.any():  # floor items close every way to the task: the furniture's free space alone
-        free = _reachable(grid.free, approach_cells(world, grid, targets), targets)
+        free = _reachable(grid.free, goals, targets)
     if by_room:
         min_cells = MIN_ROOM_FREE_M2 / grid.resolution_m**2
         xy = grid.xy_of(np.stack(list(np.indices(grid.shape)), axis=-1))
@@ -113,7 +114,7 @@ def clear_of_floor_items(world: World, grid: NavGrid) -> np.ndarray:
     floor item leaves along a passage, ``floorspots``)."""
     items = np.zeros(grid.shape, dtype=bool)
     for obj in world.objects.values():
-        if obj.kind == "item" and obj.parent is not None and world.objects[obj.parent].kind == "floor":
+        if world.on_floor(obj):
             x0, y0, x1, y1 = obj.footprint()
             (i0, j0), (i1, j1) = grid.cell_at(x0, y0), grid.cell_at(x1, y1)
             items[i0 : i1 + 1, j0 : j1 + 1] = True

@@ -182,6 +182,10 @@ class World:
         """All movable objects."""
         return [o for o in self.objects.values() if o.movable]
 
+    def on_floor(self, obj: WorldObject) -> bool:
+        """Whether ``obj`` is an item resting directly on a floor (what the base drives over)."""
+        return obj.kind == "item" and obj.parent is not None and self.objects[obj.parent].kind == "floor"
+
     # -- changes ------------------------------------------------------------------------------
     def set_open(self, name: str, is_open: bool) -> None:
         """Open or close an openable object (no precondition checks: actions do those)."""
