@@ -14,6 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from more_agent.robot_spec import ROBOT
+from more_agent.sim.motion import fixed_obstacles
 from more_agent.sim.navgrid import DEFAULT_NAV
 from more_agent.sim.world import World, WorldObject
 
@@ -130,12 +131,9 @@ def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
 
 
 def _passage_obstacles(world: World, exclude: str | None) -> np.ndarray:
-    """(n, 4) footprints of what the base drives around (walls, furniture low enough to meet it) and of
-    the floor items: what a passage runs between. Door leaves are left out: their openings are passages."""
-    rows = [w.bounds for w in world.scene.walls]
-    for obj in world.objects.values():
-        if obj.name == exclude or obj.kind in ("floor", "door"):
-            continue
-        if world.on_floor(obj) or (obj.kind == "furniture" and obj.bottom < DEFAULT_NAV.obstacle_max_bottom_m):
-            rows.append(obj.footprint())
-    return np.asarray(rows, dtype=float).reshape(-1, 4)
+    """(n, 4) footprints of what the base drives around (``motion.fixed_obstacles``: walls below a lintel,
+    low furniture) and of the floor items: what a passage runs between. Doors are left out: their openings
+    are passages."""
+    fixed, _ = fixed_obstacles(world, DEFAULT_NAV)
+    items = [o.footprint() for o in world.objects.values() if o.name != exclude and world.on_floor(o)]
+    return np.concatenate([fixed, np.asarray(items, dtype=float).reshape(-1, 4)])

@@ -48,10 +48,10 @@ def obstacle_boxes(world: World, config: NavConfig = DEFAULT_NAV) -> np.ndarray:
     """(N, 4) footprints (xmin, ymin, xmax, ymax) of everything the base collides with now.
 
     Walls and furniture never move during an episode (``WorldObject.movable``): their footprints are
-    gathered once per world and object count (``_fixed_obstacles``); only the doors' state is read on
+    gathered once per world and object count (``fixed_obstacles``); only the doors' state is read on
     every move. The rows are the fixed ones, then the closed doors.
     """
-    fixed, doors = _fixed_obstacles(world, config)
+    fixed, doors = fixed_obstacles(world, config)
     closed = [d.footprint() for d in doors if not d.is_open]
     return np.concatenate([fixed, np.asarray(closed, dtype=np.float64).reshape(-1, 4)]) if closed else fixed
 
@@ -60,7 +60,7 @@ _FIXED: list[tuple[weakref.ref[World], int, NavConfig, np.ndarray, list[WorldObj
 """The last world's fixed footprints and doors (one entry: an episode drives one world at a time)."""
 
 
-def _fixed_obstacles(world: World, config: NavConfig) -> tuple[np.ndarray, list[WorldObject]]:
+def fixed_obstacles(world: World, config: NavConfig) -> tuple[np.ndarray, list[WorldObject]]:
     """Footprints of the walls and furniture that block the base, and the world's doors (cached)."""
     if _FIXED:
         ref, n_objects, cfg, fixed, doors = _FIXED[0]

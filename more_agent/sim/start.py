@@ -6,7 +6,7 @@ in a connected component holding a base pose from which the magic actions reach 
 indoors or outdoors; the position is uniform within the drawn cell and the heading uniform. Floor
 items count as obstacles there (``clear_of_floor_items``): the world's base drives over them, but the
 robot's map shows them, and a start among them (putting_away_tools seed 1: in a corner behind a
-0.5 m box on the floor) left the robot sealed in on its own map from its first step.
+pillow on the floor, 0.46 x 0.56 m) left the robot sealed in on its own map from its first step.
 ``start_facts`` measures the start against the task: the rooms holding task objects, and the
 shortest path on that grid from the start to the nearest such pose.
 """

@@ -62,3 +62,24 @@ def test_a_floor_spot_for_an_item_never_closes_a_passage_but_the_robot_may_stand
     assert free_floor_spot(world, "kitchen_0", ITEM, rng, bounds=passage) is None
     spot = free_floor_spot(world, "kitchen_0", ITEM, rng, bounds=passage, keep_passages=False)
     assert spot is not None and 0.05 < spot[1] < 1.0
+
+
+def test_a_doorway_is_a_passage_an_item_may_not_close() -> None:
+    """Two counters make a corridor 0.9 m wide from the tiny kitchen's door into the living room. The wall
+    over the door (a lintel from 2.1 m) does not close the doorway: an item in the corridor, clear of the
+    door's keep-out, would shut the door off, so none is drawn there."""
+    world = World(scene=load_scene(TINY))
+    for name, y in (("counter_a", 0.8), ("counter_b", 3.2)):
+        world.add(
+            WorldObject(
+                name=name,
+                category="countertop",
+                kind="furniture",
+                center=np.array([4.8, y, 0.45]),
+                size=np.array([1.5, 1.5, 0.9]),
+            )
+        )
+    corridor = (4.05, 1.55, 5.55, 2.45)
+    rng = np.random.default_rng(0)
+    assert free_floor_spot(world, "living_room_0", ITEM, rng, bounds=corridor) is None
+    assert free_floor_spot(world, "living_room_0", ITEM, rng, bounds=corridor, keep_passages=False) is not None

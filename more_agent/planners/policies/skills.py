@@ -124,7 +124,7 @@ def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
     leave the base in a nook the world's base may leave but not re-enter (a move that ends within its
     clearance must gain clearance); walked backwards step by step, a way in that went there and came back
     (to grasp at a counter, then retraced) would lead into the nook again (putting_out_condiments seed 0)."""
-    spots, edges, order = _spot_graph([*body.trajectory, body.xy])
+    spots, edges, order = _spot_graph([*body.trajectory, body.xy], max_m)
     here = order[0]
     dist, previous = {here: 0.0}, {here: here}
     queue = [(0.0, here)]
@@ -144,18 +144,24 @@ def _ways_back(body: Embodiment, max_m: float) -> Iterator[list[XY]]:
             yield [spots[k] for k in reversed(way)]
 
 
-def _spot_graph(positions: Sequence[XY]) -> tuple[list[XY], list[dict[int, float]], list[int]]:
-    """Positions merged into spots (``SAME_SPOT_M``): each spot's position (its latest), the length of
-    every segment driven between two spots, and the spots latest first, each once."""
+def _spot_graph(positions: Sequence[XY], max_m: float) -> tuple[list[XY], list[dict[int, float]], list[int]]:
+    """Positions within ``max_m`` of the last one merged into spots (``SAME_SPOT_M``): each spot's position
+    (its latest), the length of every segment driven between two spots, and the spots latest first, each
+    once. A position farther away lies on no way back ``max_m`` long: it is left out, and its segments."""
     spots: list[XY] = []
     by_cell: dict[tuple[int, int], list[int]] = {}
     edges: list[dict[int, float]] = []
     order: list[int] = []
     last: int | None = None
-    for xy in reversed(positions):
+    xy_all = np.asarray(positions, dtype=float)
+    near = np.hypot(*(xy_all - xy_all[-1]).T) <= max_m
+    for xy, within in zip(reversed(positions), near[::-1].tolist()):
+        if not within:
+            last = None
+            continue
         i, j = math.floor(xy[0] / SAME_SPOT_M), math.floor(xy[1] / SAME_SPOT_M)
-        near = (k for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1) for k in by_cell.get((a, b), ()))
-        node = next((k for k in near if math.dist(spots[k], xy) <= SAME_SPOT_M), None)
+        cell = (k for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1) for k in by_cell.get((a, b), ()))
+        node = next((k for k in cell if math.dist(spots[k], xy) <= SAME_SPOT_M), None)
         if node is None:
             node = len(spots)
             spots.append(xy)
