@@ -112,9 +112,7 @@ class SceneGraphBuilder:
         for iid, info in instances.items():
             previous = self._instances.get(iid)
             if info.held and not (previous is not None and previous.held):
-                removed = self.voxels.clear_instance(iid)
-                if len(removed):
-                    self._set_box(iid, removed)
+                self._lift(iid)
             if info.held:
                 self._remembered.discard(iid)
                 self._glimpsed.pop(iid, None)
@@ -124,14 +122,16 @@ class SceneGraphBuilder:
                 and previous.open is not None
                 and info.open != previous.open
             ):
-                removed = self.voxels.clear_instance(iid)  # the leaf swung: what was seen of it no longer blocks
-                if len(removed):  # ... but the door is still there, in the state the robot knows, until seen again
-                    self._set_box(iid, removed)
-                if iid in self._boxes:
+                self._lift(iid)  # the leaf swung: what was seen of it no longer blocks, but the door is still
+                if iid in self._boxes:  # there, in the state the robot knows, until seen again
                     self._remembered.add(iid)
             self._instances[iid] = info
         held_now = [iid for iid, info in self._instances.items() if info.held]
         self._pick_up_contents(holding=bool(held_now))
+        for iid in self._carried & set(self._boxes):  # with the robot, where this frame was taken
+            lo, hi = self._boxes[iid]
+            shift = np.array([robot_xy[0] - (lo[0] + hi[0]) / 2, robot_xy[1] - (lo[1] + hi[1]) / 2, 0.0])
+            self._boxes[iid] = (lo + shift, hi + shift)
         held = held_now + sorted(self._carried)
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
         self._glimpse(depth, instance, K, T_world_cam, held)
@@ -159,13 +159,22 @@ class SceneGraphBuilder:
                     carried.add(iid)
                     break
         for iid in carried - self._carried:
-            removed = self.voxels.clear_instance(iid)
-            if len(removed):
-                self._set_box(iid, removed)
+            self._lift(iid)
             self._glimpsed.pop(iid, None)
             if iid in self._boxes:
                 self._remembered.add(iid)
         self._carried = carried
+
+    def _lift(self, iid: int) -> None:
+        """Take ``iid`` out of the voxel map (it moves with the robot, or its leaf swung) and keep its box in
+        ``_boxes``: that of the voxels it had, else of its last glimpse (a small item may show only as one),
+        else the one kept before. What frames showed decides it, not when the graph was last built: a bag
+        ingested builds once, the live robot every step (``build`` writes nothing here)."""
+        removed = self.voxels.clear_instance(iid)
+        if len(removed):
+            self._boxes[iid] = self._voxel_box(removed)
+        elif iid in self._glimpsed:
+            self._boxes[iid] = self._glimpsed[iid]
 
     def remember(self, iid: int, box_min: Sequence[float] | np.ndarray, box_max: Sequence[float] | np.ndarray) -> None:
         """An instance the robot put down itself: kept in the graph with this box (world metres) while
@@ -179,7 +188,9 @@ class SceneGraphBuilder:
 
     # ---------------------------------------------------------------- per step
     def build(self, robot_xy: Sequence[float], path_xy: Sequence[Sequence[float]] = ()) -> SceneGraph:
-        """The scene graph of everything observed so far, reduced to the robot's component.
+        """The scene graph of everything observed so far, reduced to the robot's component. It keeps no box
+        it works out (from the voxels, a glimpse): the same frames give the same graph however often it is
+        built (a bag's ingest builds once, the live robot every step); only region ids follow the builds.
 
         ``path_xy`` (the robot's path so far, oldest first) joins the components the robot can drive back
         to: it stood in them, and its path from there crosses nothing seen since (``_retraceable``). A
@@ -191,19 +202,16 @@ class SceneGraphBuilder:
         occ = self.voxels.occupancy()
         blocked = np.isin(self.voxels.top_class, self._structure_ids)
         voxels = self.voxels.instance_voxels()
+        boxes = dict(self._boxes)  # what the builder keeps, under what this map shows: the build keeps no box
         for iid, pts in voxels.items():
-            self._set_box(iid, pts)
+            boxes[iid] = self._voxel_box(pts)
         for iid, box in self._glimpsed.items():
             if iid not in voxels and iid not in self._remembered:
-                self._boxes[iid] = box
+                boxes[iid] = box
         known = sorted(i for i in set(voxels) | self._remembered | set(self._glimpsed) if i in self._instances)
         doors = [voxels[i][:, :2] for i in known if i in voxels and self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
-        for i in self._carried & set(objects):  # with the robot
-            lo, hi = self._boxes[i]
-            shift = np.array([robot[0], robot[1], 0.0]) - np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.0])
-            self._boxes[i] = (lo + shift, hi + shift)
-        centres = np.array([(self._boxes[i][0] + self._boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
+        centres = np.array([(boxes[i][0] + boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
         viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
         rg = region_graph(
             occ,
@@ -222,7 +230,7 @@ class SceneGraphBuilder:
         is_door = np.array([self._instances[i].category == "door" for i in objects], dtype=bool)
         assigned = self._within_reach(rg.graph, rg.labels, keep, centres[:, :2], rg.assigned, is_door, blocked, grid)
         return self._assemble(
-            replace(rg, assigned=assigned), region_ids, keep, objects, frontier_node, robot, occ, grid
+            replace(rg, assigned=assigned), region_ids, keep, objects, boxes, frontier_node, robot, occ, grid
         )
 
     # ---------------------------------------------------------------- helpers
@@ -253,9 +261,10 @@ class SceneGraphBuilder:
         lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
         self._glimpsed.update(zip(ids[starts].tolist(), zip(lows, highs, strict=True), strict=True))
 
-    def _set_box(self, iid: int, voxel_centres: np.ndarray) -> None:
+    def _voxel_box(self, voxel_centres: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The box (min, max corners) around voxels (n x 3 centres)."""
         half = self.config.resolution_m / 2
-        self._boxes[iid] = (voxel_centres.min(0) - half, voxel_centres.max(0) + half)
+        return voxel_centres.min(0) - half, voxel_centres.max(0) + half
 
     def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
         vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
@@ -394,6 +403,7 @@ class SceneGraphBuilder:
         region_ids: list[str],
         keep: np.ndarray,
         objects: list[int],
+        boxes: Mapping[int, tuple[np.ndarray, np.ndarray]],
         frontier_node: np.ndarray,
         robot: np.ndarray,
         occ: np.ndarray,
@@ -409,11 +419,11 @@ class SceneGraphBuilder:
         obj_nodes: dict[str, ObjectNode] = {}
         for iid, lab in zip(objects, rg.assigned.tolist()):
             if lab in kept:
-                node = self._object_node(iid, region_ids[lab])
+                node = self._object_node(iid, region_ids[lab], boxes[iid])
                 obj_nodes[node.id] = node
-        held = [iid for iid, info in self._instances.items() if info.held and iid in self._boxes]
+        held = [iid for iid, info in self._instances.items() if info.held and iid in boxes]
         for iid in held:
-            node = self._object_node(iid, None)
+            node = self._object_node(iid, None, boxes[iid])
             obj_nodes[node.id] = node
 
         regions: dict[str, RegionNode] = {}
@@ -479,9 +489,9 @@ class SceneGraphBuilder:
         ]
         return relations
 
-    def _object_node(self, iid: int, region_id: str | None) -> ObjectNode:
+    def _object_node(self, iid: int, region_id: str | None, box: tuple[np.ndarray, np.ndarray]) -> ObjectNode:
         info = self._instances[iid]
-        lo, hi = self._boxes[iid]
+        lo, hi = box
         return ObjectNode(
             id=info.label,
             category=info.category,

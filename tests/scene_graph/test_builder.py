@@ -184,6 +184,27 @@ def test_a_small_item_sharing_its_voxels_with_its_support_stays_in_the_graph() -
     assert builder.build((1.4, 2.0)).objects["apple A"].region_id is None
 
 
+def test_the_graph_follows_the_frames_not_how_often_it_was_built() -> None:
+    """A bag is ingested with one build at its end, the live robot builds every step: both must give one
+    graph. The egg-sized apple shows only as a glimpse; picked up, it must stay in hand whether or not a
+    graph was built while it lay on the table (a build copied its glimpse into the builder's own boxes,
+    and the pick-up read those: Rs_int's cup in the sack, live vs ingested, 0.07 m apart)."""
+    boxes, infos = two_rooms(cabinet=False)
+    boxes = [b for b in boxes if b.instance != 4] + [Box((1.3, 3.1, 0.75), (1.36, 3.15, 0.79), "apple", 4)]
+    held = {**infos, 4: InstanceInfo(label="apple A", category="apple", held=True)}
+    graphs = []
+    for build_on_the_way in (True, False):
+        builder = new_builder()
+        explore(builder, boxes, infos, [(1.4, 2.0)], n_yaw=8)
+        if build_on_the_way:
+            builder.build((1.4, 2.0))
+        explore(builder, boxes, held, [(1.4, 2.0)], n_yaw=1)
+        graphs.append(builder.build((1.4, 2.0)))
+    live, once = graphs
+    assert live.held_object is not None and live.held_object.id == "apple A"
+    assert once.model_dump(exclude={"step"}) == live.model_dump(exclude={"step"})  # but the count of builds
+
+
 def _rooms_behind_a_slit() -> tuple[list[Box], dict[int, InstanceInfo]]:
     """Two rooms (x in [0, 4] and [4.15, 8.15]) joined by a doorway (y 1.9..2.1) narrower on the map
     than the graph's clearance, with a table in each."""
