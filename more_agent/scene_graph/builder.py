@@ -81,6 +81,9 @@ class SceneGraphBuilder:
         self._instances: dict[int, InstanceInfo] = {}
         self._viewpoints: dict[int, dict[tuple[int, int], tuple[float, float]]] = {}
         self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        """Boxes of instances the frames no longer show as they are: lifted out of the voxel map (held,
+        carried, a door whose leaf swung: ``_lift``) or put down (``remember``). ``build`` reads them and keeps
+        none of the boxes it works out, so the graph follows the frames, not when it was built."""
         self._remembered: set[int] = set()
         self._carried: set[int] = set()
         """Instances resting on or in the held one (directly or through others): they travel with it."""
