@@ -157,10 +157,11 @@ class BagRecorder:
         released = self._held if self._held is not None and self._held != world.robot.held else None
         placed = {}
         if released is not None:  # with what rode on it, as the simulator's robot reports it
-            changed.append(world.get(released).instance_id)
-            for obj in [world.get(released), *world.descendants(released)]:
-                lo, hi = obj.box()
-                placed[obj.instance_id] = (tuple(map(float, lo)), tuple(map(float, hi)))
+            put_down = world.get(released)
+            changed.append(put_down.instance_id)
+            for rider in [put_down, *world.descendants(released)]:
+                lo, hi = rider.box()
+                placed[rider.instance_id] = (tuple(map(float, lo)), tuple(map(float, hi)))
         for iid in changed:
             obj = by_id[iid]
             entries.setdefault(
