@@ -36,7 +36,7 @@ HEAD_HEIGHT_M = ROBOT.camera.height_m
 """Height of the optical centre above the ground in metres."""
 
 MAX_RANGE_M = ROBOT.camera.max_range_m
-"""Sensor range: pixels whose z-depth exceeds it are invalid (paper S.2)."""
+"""Sensor range: pixels farther than this from the camera are invalid (paper S.2), depth and semantics alike."""
 
 
 @dataclass(frozen=True)

@@ -318,10 +318,12 @@ def _cast(
     inst: np.ndarray,
     rgb: np.ndarray,
 ) -> None:
-    """Nearest hit of each ray origin + t * rot @ rays[r], t in [0, max_t]; NaN / 0 / 0 / black on a miss.
+    """Nearest hit of each ray origin + t * rot @ rays[r] within ``max_t`` metres of the camera; NaN / 0 / 0 /
+    black on a miss.
 
-    Camera-frame rays have z = 1, so t is the z-depth. The colour is the class's palette entry dimmed
-    by the face hit and by depth.
+    Camera-frame rays have z = 1, so t is the z-depth; the range is a distance from the camera (the sensor
+    range of paper S.2, as the mapper applies it), so a ray off the optical axis stops at a smaller z-depth.
+    The colour is the class's palette entry dimmed by the face hit and by depth.
     """
     mailbox = np.full(lo.shape[0], -1, dtype=np.int64)
     zlo, zhi = np.inf, -np.inf
@@ -332,8 +334,9 @@ def _cast(
         rgb[r, 0], rgb[r, 1], rgb[r, 2] = 0, 0, 0
         d = _ray_direction(rot, rays, r)
         inv = (1.0 / d[0], 1.0 / d[1], 1.0 / d[2])
+        reach = max_t / np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])  # the z-depth at max_t metres
         # clip the ray to the grid's xy extent, the boxes' z extent and the range
-        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, max_t)
+        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, reach)
         tn, tf = _clip(y0, y0 + ny * cell, origin[1], inv[1], tn, tf)
         tn, tf = _clip(zlo, zhi, origin[2], inv[2], tn, tf)
         if tn > tf:
@@ -341,7 +344,7 @@ def _cast(
         best, best_b, best_f = _walk_grid(
             r, origin, d, inv, tn, tf, x0, y0, cell, nx, ny, start, items, lo, hi, mailbox
         )
-        if best_b >= 0 and best <= max_t:
+        if best_b >= 0 and best <= reach:
             depth[r], sem[r], inst[r] = best, box_sem[best_b], box_inst[best_b]
             shade = (0.80 if best_f == 0 else 0.65 if best_f == 1 else 1.0) * (1.0 - 0.35 * best / max_t)
             for ch in range(3):

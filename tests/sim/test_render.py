@@ -191,6 +191,31 @@ def test_window_is_see_through_and_range_is_five_metres():
     assert np.isnan(far.depth[128, 128]) and np.nanmax(far.depth) <= 5.0
 
 
+def test_the_range_is_a_distance_from_the_camera_not_a_z_depth():
+    """A wall 4.5 m ahead spans the whole image; towards the image's edges it lies farther than 5 m from the
+    camera though its z-depth is 4.5 m: invalid there, depth and semantics alike, as the mapper reads the
+    range (the robot's `observed` set counted objects there that its map never held)."""
+    h = T / 2
+    scene = Scene(
+        name="hall", bounds=(-h, -6 - h, 12 + h, 6 + h),
+        rooms=[Room(id="hall_0", type="corridor", bounds=(0, -6, 12, 6))],
+        walls=[Wall(bounds=(-h, -6 - h, h, 6 + h))],
+    )
+    world = World.from_scene(scene)
+    world.set_robot_pose(4.55, 0.0, math.pi)  # the wall's face 4.5 m ahead
+    frame = Renderer(Camera(pitch_deg=0.0)).render(world)
+    wall = world.class_names.index("wall")
+    row = 128  # level: every pixel of the row meets the wall's plane
+    assert frame.depth[row, 128] == pytest.approx(4.5, abs=1e-4) and frame.semantic[row, 128] == wall
+    rays = Camera(pitch_deg=0.0).pixel_rays().reshape(256, 256, 3)
+    far = np.linalg.norm(rays[row], axis=1) * 4.5 > 5.0
+    assert far.any() and not far.all()
+    assert np.isnan(frame.depth[row, far]).all() and not frame.semantic[row, far].any()
+    assert (frame.semantic[row, ~far] == wall).all()
+    hits = np.isfinite(frame.depth)
+    assert np.all(np.linalg.norm(rays[hits], axis=1) * frame.depth[hits] <= 5.0 + 1e-4)
+
+
 def test_rendering_is_deterministic_and_cached():
     world = two_rooms()
     world.set_robot_pose(1.0, 1.0, 0.7)
