@@ -300,6 +300,7 @@ def _cast(
     origin: np.ndarray,
     rot: np.ndarray,
     rays: np.ndarray,
+    reach: np.ndarray,
     max_t: float,
     x0: float,
     y0: float,
@@ -318,12 +319,11 @@ def _cast(
     inst: np.ndarray,
     rgb: np.ndarray,
 ) -> None:
-    """Nearest hit of each ray origin + t * rot @ rays[r] within ``max_t`` metres of the camera; NaN / 0 / 0 /
-    black on a miss.
+    """Nearest hit of each ray origin + t * rot @ rays[r], t in [0, reach[r]]; NaN / 0 / 0 / black on a miss.
 
-    Camera-frame rays have z = 1, so t is the z-depth; the range is a distance from the camera (the sensor
-    range of paper S.2, as the mapper applies it), so a ray off the optical axis stops at a smaller z-depth.
-    The colour is the class's palette entry dimmed by the face hit and by depth.
+    Camera-frame rays have z = 1, so t is the z-depth; ``reach[r]`` is the z-depth at which ray r is ``max_t``
+    metres from the camera (the sensor range of paper S.2 is a distance, as the mapper applies it:
+    :func:`ray_reach`). The colour is the class's palette entry dimmed by the face hit and by depth.
     """
     mailbox = np.full(lo.shape[0], -1, dtype=np.int64)
     zlo, zhi = np.inf, -np.inf
@@ -334,9 +334,8 @@ def _cast(
         rgb[r, 0], rgb[r, 1], rgb[r, 2] = 0, 0, 0
         d = _ray_direction(rot, rays, r)
         inv = (1.0 / d[0], 1.0 / d[1], 1.0 / d[2])
-        reach = max_t / np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])  # the z-depth at max_t metres
         # clip the ray to the grid's xy extent, the boxes' z extent and the range
-        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, reach)
+        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, reach[r])
         tn, tf = _clip(y0, y0 + ny * cell, origin[1], inv[1], tn, tf)
         tn, tf = _clip(zlo, zhi, origin[2], inv[2], tn, tf)
         if tn > tf:
@@ -344,11 +343,16 @@ def _cast(
         best, best_b, best_f = _walk_grid(
             r, origin, d, inv, tn, tf, x0, y0, cell, nx, ny, start, items, lo, hi, mailbox
         )
-        if best_b >= 0 and best <= reach:
+        if best_b >= 0 and best <= reach[r]:
             depth[r], sem[r], inst[r] = best, box_sem[best_b], box_inst[best_b]
             shade = (0.80 if best_f == 0 else 0.65 if best_f == 1 else 1.0) * (1.0 - 0.35 * best / max_t)
             for ch in range(3):
                 rgb[r, ch] = np.uint8(palette[sem[r], ch] * shade + 0.5)
+
+
+def ray_reach(rays: np.ndarray, max_range_m: float) -> np.ndarray:
+    """Per camera-frame ray (z = 1), the z-depth at which it is ``max_range_m`` from the camera."""
+    return max_range_m / np.linalg.norm(rays, axis=1)
 
 
 def class_colors(class_names: list[str]) -> np.ndarray:
@@ -373,6 +377,7 @@ class Renderer:
     def __init__(self, camera: Camera | None = None) -> None:
         self.camera = camera or Camera()
         self._rays = self.camera.pixel_rays()
+        self._reach = ray_reach(self._rays, self.camera.max_range_m)
         self._K = self.camera.intrinsics()
         self._world: World | None = None
         self._version = -1
@@ -404,6 +409,7 @@ class Renderer:
             np.ascontiguousarray(T[:3, 3]),
             np.ascontiguousarray(T[:3, :3]),
             self._rays,
+            self._reach,
             cam.max_range_m,
             *g.grid.origin_xy,
             g.grid.resolution_m,
