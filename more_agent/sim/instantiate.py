@@ -468,6 +468,10 @@ class _Builder:
         obj, room = self.world.objects[name], self.world.objects[floor].room
         half = obj.size[:2] / 2 + FLOOR_MARGIN_M
         xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area)
+        if xy is None:  # every spot closes a passage: bddl still puts it on this floor, which the base drives over
+            xy = free_floor_spot(
+                self.world, room, half, self.rng, near=near, exclude=name, bounds=area, keep_passages=False
+            )
         if xy is None:
             where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
             raise InstantiationError(f"no free spot for {name} {where}")
