@@ -119,7 +119,7 @@ def classify_failure(
 
 def is_modelled(condition: GoalCondition) -> bool:
     """Whether the world models the predicate of a goal condition; no robot meets one it does not model
-    (``attached``: docs/tasks.md)."""
+    (``cooked``, ``covered``, ...: docs/tasks.md)."""
     return predicate_of(condition) in PREDICATES
 
 

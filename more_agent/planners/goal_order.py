@@ -11,8 +11,18 @@ from more_agent.goal import REARRANGE_PREDICATES, ROBOT_NAME, Literal
 ORACLE_PREDICATES = REARRANGE_PREDICATES
 """Goal predicates the oracle knows how to achieve: those of a rearrangement."""
 
+PLACED_AS = {"attached": "ontop"}
+"""Goal predicates that a placement makes true, and the placement: ``attached(a, b)`` holds once a rests on b
+(``sim.predicates.is_attached``)."""
+
 PUT_DOWN_MAX_TOP_M = 1.5
 """Furniture taller than this (trees, wardrobes) is not used to put things down on."""
+
+
+def as_placed(lit: Literal) -> Literal:
+    """``lit`` as the skills achieve it: an ``attached`` literal becomes the ``ontop`` placement that attaches."""
+    placement = PLACED_AS.get(lit.predicate)
+    return lit if placement is None else Literal(placement, lit.args, lit.negated)
 
 
 def _group(lit: Literal) -> int:

@@ -24,7 +24,7 @@ from collections.abc import Collection
 
 from more_agent.goal import ROBOT_NAME, Literal
 from more_agent.planners.base import DONE, EpisodeContext, Step, StepTrace
-from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, order_literals
+from more_agent.planners.goal_order import ORACLE_PREDICATES, PUT_DOWN_MAX_TOP_M, as_placed, order_literals
 from more_agent.planners.policies import Embodiment
 from more_agent.records import FailureReason, LLMUsage
 from more_agent.robot import ActionResult
@@ -89,11 +89,16 @@ def merge_placements(world: World, literals: list[Literal]) -> list[Literal]:
     return out
 
 
+def placements(goals: GoalChecker, option: int) -> list[Literal]:
+    """The ground literals of goal option ``option`` as the skills achieve them (``goal_order.as_placed``)."""
+    return [as_placed(lit) for lit in goals.ground_literals(option)]
+
+
 def choose_option(goals: GoalChecker, world: World, exclude: Collection[int] = frozenset()) -> int | None:
     """The ground goal option (not in ``exclude``) with the fewest literals the oracle cannot achieve, then the fewest unmet."""
 
     def cost(i: int) -> tuple[int, int, int]:
-        lits = goals.ground_literals(i)
+        lits = placements(goals, i)
         unsupported = sum(unsupported_reason(world, lit) is not None for lit in lits)
         unmet = sum(unsupported_reason(world, lit) is None and not literal_holds(world, lit) for lit in lits)
         return unsupported, unmet, i
@@ -145,7 +150,7 @@ class OraclePlanner:
         if option is None:
             return False
         self._tried.add(option)
-        literals = self._goals.ground_literals(option)
+        literals = placements(self._goals, option)
         self._skipped = {lit: why for lit in literals if (why := unsupported_reason(self._world, lit)) is not None}
         supported = [lit for lit in literals if lit not in self._skipped]
         self._literals = order_literals(merge_placements(self._world, supported))

@@ -184,6 +184,11 @@ def is_cloth(category: str) -> bool:
     return has_ability(category, "cloth")
 
 
+def is_attachable(category: str) -> bool:
+    """True if the category attaches to another attachable thing ('attachable': a camera to a tripod)."""
+    return has_ability(category, "attachable")
+
+
 def can_hold_things(category: str) -> bool:
     """True if things can be put inside (the 'fillable' ability: cabinets, fridge, car; not a laptop)."""
     return has_ability(category, "fillable")

@@ -26,7 +26,8 @@ Steps (all deterministic for a given task, scene and seed):
    labelled when first observed (``TaskInstance.labels``, :mod:`more_agent.sim.labels`).
 8. Every supported init literal is evaluated through our bddl backend; a false one raises
    ``InstantiationError`` naming it. Literals that do not apply to rearrangement (cooked,
-   covered, filled, ...) and literals over virtual scopes are kept in ``unsupported_literals``.
+   covered, filled, ...), ``attached`` (``predicates.NOT_SET_UP``) and literals over virtual scopes
+   are kept in ``unsupported_literals``.
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ from more_agent.sim.floorspots import free_floor_spot
 from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.packing import support_surface
-from more_agent.sim.predicates import PREDICATES, ROBOT_NAME
+from more_agent.sim.predicates import NOT_SET_UP, PREDICATES, ROBOT_NAME
 from more_agent.sim.scene import Scene
 from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
 from more_agent.sim.tasks import (
@@ -389,7 +390,7 @@ class _Builder:
                 if pred == "ontop":
                     self.agent_floor = self.scope.get(args[1])
                 continue
-            if pred not in PREDICATES or any(a in self.virtual for a in args):
+            if pred not in PREDICATES or pred in NOT_SET_UP or any(a in self.virtual for a in args):
                 self.unsupported.append(literal_text(lit))
             elif pred == "open":
                 states.append(lit)

@@ -16,6 +16,10 @@ Semantics, in the symbolic world:
 - ``touching(a, b)``: one rests directly on / in the other, or their boxes are within
   ``TOUCH_GAP_M`` of each other.
 - ``grasped(robot, a)``: the robot holds a.
+- ``attached(a, b)``: a rests directly on top of b and both are attachable (BEHAVIOR-1K's ``attachable``
+  ability): OmniGibson attaches such objects when one is put on the other's mount, and the paper words
+  attach_a_camera_to_a_tripod as "put the digital camera on top the tripod". The world's set-up never
+  attaches anything (``NOT_SET_UP``).
 Every other predicate (cooked, covered, filled, ...) is not modelled: ``holds`` reads it as False.
 """
 
@@ -26,6 +30,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from more_agent.goal import ROBOT_NAME
+from more_agent.sim.catalog import is_attachable
 from more_agent.sim.world import World, WorldObject, floor_name
 
 NEXTTO_GAP_M = 0.3
@@ -97,6 +102,14 @@ def is_touching(world: World, a: str, b: str) -> bool:
     return max(_xy_gap(*pair), _z_gap(*pair)) <= TOUCH_GAP_M
 
 
+def is_attached(world: World, name: str, mount: str) -> bool:
+    """``attached(a, b)``: ``name`` rests directly on top of ``mount`` and both are attachable."""
+    pair = _objects(world, name, mount)
+    if pair is None or pair[0].parent != mount or pair[0].relation != "ontop":
+        return False
+    return is_attachable(pair[0].category) and is_attachable(pair[1].category)
+
+
 def is_grasped(world: World, agent: str, name: str) -> bool:
     """``grasped(robot, a)``: the robot holds a."""
     return agent == ROBOT_NAME and world.robot.held == name
@@ -110,8 +123,13 @@ PREDICATES: dict[str, Callable[..., bool]] = {
     "under": is_under,
     "touching": is_touching,
     "grasped": is_grasped,
+    "attached": is_attached,
 }
 """The predicates the world models, by bddl name."""
+
+NOT_SET_UP = frozenset({"attached"})
+"""Modelled predicates that the world's set-up does not make true from a task's init literals: what hangs on a
+fixture lies at a free spot instead, and the literal is kept in ``TaskInstance.unsupported_literals``."""
 
 
 def holds(world: World, predicate: str, args: Sequence[str]) -> bool:

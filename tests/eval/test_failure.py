@@ -120,11 +120,10 @@ def test_a_wrong_instance_names_a_needed_one_never_seen_by_its_world_name() -> N
 
 
 def test_a_goal_the_world_cannot_meet_is_not_lost_to_what_was_never_seen(world: World, labels: InstanceLabels) -> None:
-    """attach_a_camera_to_a_tripod: ``attached`` is not modelled, so the planner calls done() at once; that
-    the camera was never seen explains nothing (docs/evaluation.md: done_early)."""
-    attached = GoalCondition(text="(attached canned_food_1 bottom_cabinet_0)", satisfied=False,
-                             objects=["canned_food_1", "bottom_cabinet_0"])
-    record = _record(goal_conditions=[attached], observed_objects=[], done_called=True, termination="done")
+    """A goal over a predicate the world does not model (``cooked``) is met by no robot: that its object was
+    never seen explains nothing (docs/evaluation.md: done_early)."""
+    cooked = GoalCondition(text="(cooked canned_food_1)", satisfied=False, objects=["canned_food_1"])
+    record = _record(goal_conditions=[cooked], observed_objects=[], done_called=True, termination="done")
     failure = classify_failure(record, world, labels)
     assert failure is not None and failure.cause == "done_early"
     negated = GoalCondition(text="(not (inside canned_food_1 bottom_cabinet_0))", satisfied=False,

@@ -5,23 +5,25 @@ from __future__ import annotations
 from dataclasses import dataclass
 from types import SimpleNamespace
 
+import numpy as np
 from bddl.activity import Conditions
 
 from more_agent.goal import GoalSpec
 from more_agent.planners.base import EpisodeContext, make_planner
-from more_agent.planners.goal_order import order_literals
+from more_agent.planners.goal_order import as_placed, order_literals
 from more_agent.planners.oracle import OraclePlanner, merge_placements
 from more_agent.sim.bddl_backend import ScopeObject
 from more_agent.sim.env import SimRobot
 from more_agent.sim.goals import GoalChecker, Literal, PrivilegedContext
 from more_agent.sim.predicates import ROBOT_NAME
-from more_agent.sim.world import World
+from more_agent.sim.world import World, WorldObject
 from tests.sim.test_navgrid import labelled, two_room_world
 
 SCOPES = {
     "apple_0": "apple.n.01_1", "bowl_0": "bowl.n.01_1", "box_0": "carton.n.02_1",
     "fridge_0": "electric_refrigerator.n.01_1", "cabinet_0": "cabinet.n.01_1", "table_0": "table.n.02_1",
     "door_0": "door.n.01_1", "floor_kitchen_0": "floor.n.01_1", "floor_living_room_0": "floor.n.01_2",
+    "digital_camera_0": "digital_camera.n.01_1", "camera_tripod_0": "camera_tripod.n.01_1",
     ROBOT_NAME: "agent.n.01_1",
 }
 """The bddl scope each object of ``two_room_world`` stands for."""
@@ -115,6 +117,24 @@ def test_removal_goal_puts_item_elsewhere():
     log, _ = solve(world, goals)
     assert goals.check(world).all_met and world.get("box_0").parent != "floor_kitchen_0"
     assert log[0][:2] == ("go_to_and_grasp", ("box_0",))
+
+
+def test_attached_is_achieved_by_putting_the_camera_on_the_tripod():
+    """attach_a_camera_to_a_tripod's goal, ``attached`` (the paper: "put the digital camera on top the
+    tripod"), through the real goal checker; the grounded planner reads it the same way (``as_placed``)."""
+    world = two_room_world()
+    for name, size in [("digital_camera_0", 0.1), ("camera_tripod_0", 0.3)]:
+        world.add(WorldObject(name=name, category=name[:-2], kind="item", center=np.zeros(3), size=np.full(3, size)))
+        world.place_on_floor_at(name, "floor_living_room_0", (6.0 + 10 * size, 2.0))
+    goal = Literal("attached", ("digital_camera_0", "camera_tripod_0"))
+    goals = bddl_goals(world, [goal])
+    assert not goals.check(world).all_met
+    log, note = solve(world, goals)
+    assert goals.check(world).all_met and note == "all goal conditions hold"
+    assert [a[:2] for a in log] == [("go_to_and_grasp", ("digital_camera_0",)),
+                                    ("go_to_and_place_ontop", ("camera_tripod_0",))]
+    assert as_placed(goal) == ontop("digital_camera_0", "camera_tripod_0")
+    assert as_placed(Literal("attached", ("a", "b"), True)) == ontop("a", "b", negated=True)
 
 
 def test_unsupported_literal_is_explained():

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from more_agent.sim.predicates import ROBOT_NAME, holds
+from more_agent.sim.world import WorldObject
 from tests.sim.test_navgrid import two_room_world
 
 
@@ -33,3 +36,22 @@ def test_names_the_world_lacks_and_unmodelled_predicates_read_false() -> None:
     assert not holds(world, "inside", ("water.n.06_1", "fridge_0"))
     assert not holds(world, "ontop", ("bowl_0", "dust.n.01_1"))
     assert not holds(world, "cooked", ("apple_0",))
+
+
+def test_attached_is_an_attachable_thing_put_directly_on_another() -> None:
+    """OmniGibson attaches a camera put on a tripod's mount (the paper: "put the digital camera on top the
+    tripod"); a bowl on a table is not attached, nor is a camera on a plate on the tripod."""
+    world = two_room_world()
+    for name, size in [("digital_camera_0", 0.1), ("camera_tripod_0", 0.3), ("plate_0", 0.2)]:
+        world.add(WorldObject(name=name, category=name[:-2], kind="item", center=np.zeros(3), size=np.full(3, size)))
+    world.place("camera_tripod_0", "floor_kitchen_0", "ontop")
+    world.place("digital_camera_0", "floor_kitchen_0", "ontop")
+    assert not holds(world, "attached", ("digital_camera_0", "camera_tripod_0"))
+    world.place("digital_camera_0", "camera_tripod_0", "ontop")
+    assert holds(world, "attached", ("digital_camera_0", "camera_tripod_0"))
+    assert not holds(world, "attached", ("camera_tripod_0", "digital_camera_0"))
+    assert not holds(world, "attached", ("bowl_0", "table_0"))  # on top, but neither is attachable
+    world.place("plate_0", "camera_tripod_0", "ontop")
+    world.place("digital_camera_0", "plate_0", "ontop")
+    assert holds(world, "ontop", ("digital_camera_0", "camera_tripod_0"))
+    assert not holds(world, "attached", ("digital_camera_0", "camera_tripod_0"))  # on the tripod, not on its mount

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from more_agent.goal import Literal, TaskGoal
-from more_agent.planners.goal_order import ORACLE_PREDICATES, order_literals
+from more_agent.planners.goal_order import ORACLE_PREDICATES, as_placed, order_literals
 
 
 @dataclass(frozen=True)
@@ -20,8 +20,8 @@ class Agenda:
 
 
 def agenda_of(goal: TaskGoal) -> Agenda:
-    """The agenda of ``goal``'s first option."""
-    option = goal.options[0]
+    """The agenda of ``goal``'s first option, its ``attached`` literals as the placements that attach."""
+    option = [as_placed(lit) for lit in goal.options[0]]
     skipped = [lit for lit in option if lit.predicate not in ORACLE_PREDICATES]
     literals = order_literals([lit for lit in option if lit not in skipped])
     return Agenda(goal, tuple(literals), tuple(skipped))
