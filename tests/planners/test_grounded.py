@@ -8,9 +8,10 @@ from pathlib import Path
 import pytest
 
 from more_agent.eval.episode import reset_planner, run_episode
+from more_agent.goal import TaskGoal
 from more_agent.planners.base import Step, default_planner, make_planner
 from more_agent.planners.grounded import GroundedPlanner
-from more_agent.planners.grounded.agenda import Agenda
+from more_agent.planners.grounded.agenda import Agenda, agenda_of
 from more_agent.planners.grounded.belief import (
     GROUND_M,
     NEW_FLOOR_M2,
@@ -38,9 +39,11 @@ from more_agent.planners.grounded.search import (
     RoomMass,
     closed_containers,
     container_likelihood,
+    delivered_rooms,
     far_frontiers,
     fits,
     found_rooms,
+    furniture_destination,
     informative,
     is_furniture_scope,
     item_rooms,
@@ -63,7 +66,7 @@ from more_agent.planners.room_types import (
     listed_share,
 )
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import never_inside, together_share
+from more_agent.planners.whereabouts import destination_share, never_inside, together_share
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
 from more_agent.scene_graph import ObjectNode, RegionNode
@@ -846,3 +849,30 @@ def test_containers_too_small_or_never_holding_the_missing_item_are_opened_last(
     closed, others = closed_containers(belief, sit, bags, [suitcase])  # no evidence: any container it fits
     assert all(fits(frozenset({"suitcase"}), o.category) for o in closed)
     assert all(not fits(frozenset({"suitcase"}), o.category) for o in others)
+
+
+def test_what_goes_into_a_car_is_looked_for_by_the_car() -> None:
+    """Hamburgers are kept in kitchens, but bddl's activities that load a car set its load out beside it, on the
+    lawn (``destination_share``, the activity itself left out): the hamburger goes into a bag that goes into the
+    car, so the search expects it where cars stand, and once the car is found, in that room (picnic seed 1 had
+    opened a kitchen's 19 cabinets before it reached the lawn at step 41)."""
+    burger, bag, car = "hamburger.n.01_1", "bag.n.06_1", "car.n.01_1"
+    goal = TaskGoal(
+        options=((Literal("inside", (burger, bag)), Literal("inside", (bag, car))),),
+        categories={burger: frozenset({"hamburger"}), bag: frozenset({"bag"}), car: frozenset({"car"})},
+        named={},
+        floor_rooms={},
+        robot="agent.n.01_1",
+        moved=frozenset({burger, bag}),
+        activity="packing_picnic_food_into_car",
+    )
+    agenda = agenda_of(goal)
+    assert furniture_destination(agenda, burger) == car and furniture_destination(agenda, car) is None
+    share = destination_share("car.n.01", goal.activity)
+    assert share is not None and share > 0.5 and destination_share("car.n.01", "") != share  # left out
+    kept = item_rooms(goal, [burger])
+    assert kept["kitchen"] > kept["garden"]
+    expected = delivered_rooms(agenda, burger, {})
+    assert max(expected, key=expected.__getitem__) == "garden" and expected["kitchen"] < kept["kitchen"]
+    assert max(delivered_rooms(agenda, burger, {car: "garage"}).items(), key=lambda kv: kv[1])[0] == "garage"
+    assert room_mass(agenda, [burger, bag]).sides == frozenset({True})  # outdoors: the lawn before the kitchen

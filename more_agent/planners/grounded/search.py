@@ -18,11 +18,18 @@ from more_agent.planners.grounded.situation import Situation
 from more_agent.planners.grounded.steps import Choice, object_step, put_down
 from more_agent.planners.room_types import OUTDOOR_ROOM_TYPES, furniture_rooms, is_furniture, listed_share
 from more_agent.planners.targets import Area
-from more_agent.planners.whereabouts import container_prior, container_share, never_inside, room_prior, together_share
+from more_agent.planners.whereabouts import (
+    container_prior,
+    container_share,
+    destination_share,
+    never_inside,
+    room_prior,
+    together_share,
+)
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
 from more_agent.sim.catalog import can_hold_things, category_size, is_scene_fixture, is_surface, sized_categories
-from more_agent.vocabulary import scope_synset
+from more_agent.vocabulary import RELATIONS, scope_synset
 
 OPENS_BEFORE_EXPLORING = 3
 """Containers opened to look inside, one after the other, before the search explores again."""
@@ -69,7 +76,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     note = f"looking for {', '.join(goal.named.get(s, s) for s in missing) or 'the room of ' + lit.text}"
     items = [s for s in missing if not is_furniture_scope(agenda, s)]
     searching_items = not missing or bool(items)
-    mass = room_mass(agenda, missing, found_rooms(belief, agenda))
+    mass = room_mass(agenda, missing, found_rooms(belief, agenda), destination_rooms(belief, agenda))
     closed, unlikely_containers = (
         closed_containers(belief, sit, agenda, items + other_missing_items(belief, agenda, items))
         if searching_items
@@ -260,7 +267,8 @@ def room_to_explore(
     after a few metres, and a room nearly seen yields to one barely seen); then the nearest. ``mass``: the
     step's :func:`room_mass` when the caller has it."""
     cats = [c for s in missing for c in agenda.goal.categories.get(s, ()) if is_furniture(c)]
-    mass = room_mass(agenda, missing, found_rooms(belief, agenda)) if mass is None else mass
+    if mass is None:
+        mass = room_mass(agenda, missing, found_rooms(belief, agenda), destination_rooms(belief, agenda))
     open_regions = [rid for rid, r in sit.graph.regions.items() if r.frontiers]
     gain = unseen_floor(sit, open_regions)
 
@@ -329,7 +337,9 @@ def room_tier(belief: Belief, region: str, mass: RoomMass) -> int:
     return LIKELY if likely else UNLIKELY
 
 
-def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ()) -> RoomMass:
+def room_mass(
+    agenda: Agenda, missing: Sequence[str], found: Sequence[str] = (), placed: dict[str, str] | None = None
+) -> RoomMass:
     """Room type -> how many of the ``missing`` objects to expect in a room of that type: where the missing
     items are kept (:func:`item_rooms`, one in all) plus, for each missing piece of furniture, the share of
     its kind standing in such rooms (:func:`~more_agent.planners.room_types.furniture_rooms`). Beer, kept as
@@ -345,14 +355,16 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
     one activity placing branches in a kitchen is all the corpus says of branches, and bathrooms list more
     trash cans than gardens do. Before any is found, such furniture is where the missing items are likeliest,
     with that probability: the weeds' trash can on the lawn, not in the bathrooms that list trash cans
-    (hoe_weeds seed 2). Where each missing object is likeliest, indoors or out, gives the
-    mass's ``sides`` (:func:`room_tier`)."""
+    (hoe_weeds seed 2). An item the goal puts into or onto a piece of furniture starts in that furniture's room
+    with the share the corpus gives (:func:`delivered_rooms`; ``placed``: destination scope -> the room type it
+    was found in). Where each missing object is likeliest, indoors or out, gives the mass's ``sides``
+    (:func:`room_tier`)."""
     goal = agenda.goal
     stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
     items = [s for s in missing if s not in stands and s not in stays]
-    each_item = [(item_rooms(goal, [s]), _set_out(goal, s)) for s in items]
+    each_item = [(delivered_rooms(agenda, s, placed or {}), _set_out(goal, s)) for s in items]
     items_together = (mean_rooms([rooms for rooms, _ in each_item]), any(out for _, out in each_item))
     known = [*found, *(kind for s, kind in stays.items() if _set_out(goal, s))]
     together = {kind: n / len(known) for kind, n in Counter(known).items()}
@@ -377,6 +389,52 @@ def room_mass(agenda: Agenda, missing: Sequence[str], found: Sequence[str] = ())
             mass[kind] = mass.get(kind, 0.0) + n
     # the sides: each item by its own evidence (a bag kept on a lawn, the money indoors)
     return RoomMass(mass, frozenset().union(*(sides_of(expected(*part)) for part in [*objects, *each_item])))
+
+
+def delivered_rooms(agenda: Agenda, item: str, placed: dict[str, str]) -> dict[str, float]:
+    """Room type -> where the missing ``item`` is: where it is kept (:func:`item_rooms`) and, when the goal puts it
+    into or onto a piece of furniture (:func:`furniture_destination`), that furniture's room with the share of
+    such items that bddl's other activities set out there (:func:`~more_agent.planners.whereabouts.destination_share`:
+    what is loaded into a car waits beside it on the lawn; packing_picnic_food_into_car seed 1 opened a kitchen's
+    19 cabinets for the hamburgers that lay on the lawn). The furniture's room is the one it was found in
+    (``placed``), else where its kind stands (:func:`~more_agent.planners.room_types.furniture_rooms`)."""
+    goal, own = agenda.goal, item_rooms(agenda.goal, [item])
+    target = furniture_destination(agenda, item)
+    share = destination_share(scope_synset(target), goal.activity) if target is not None else None
+    if target is None or share is None:
+        return own
+    kind = placed.get(target)
+    there = {kind: 1.0} if kind else furniture_rooms(goal.categories.get(target, ()))
+    if not there or not own:
+        return there or own
+    return {k: share * there.get(k, 0.0) + (1 - share) * own.get(k, 0.0) for k in {*own, *there}}
+
+
+def furniture_destination(agenda: Agenda, item: str) -> str | None:
+    """The piece of furniture the goal puts ``item`` into or onto, directly or in what it goes into (the
+    hamburger goes into a bag, the bag into the car); None when it goes on a floor or nothing standing."""
+    goal, seen = agenda.goal, {item}
+    while True:
+        lit = next(
+            (x for x in agenda.literals if not x.negated and x.predicate in RELATIONS and x.args[0] == item), None
+        )
+        if lit is None or goal.is_floor(lit.args[1]) or lit.args[1] in seen:
+            return None
+        item = lit.args[1]
+        if is_furniture_scope(agenda, item):
+            return item
+        seen.add(item)
+
+
+def destination_rooms(belief: Belief, agenda: Agenda) -> dict[str, str]:
+    """Scope -> the room type of the region the furniture bound to it was found in, for the goal's furniture."""
+    out = {}
+    for scope, label in belief.bound.items():
+        region = belief.found_in.get(label)
+        kind = belief.room_types.get(region) if region is not None else None
+        if kind and is_furniture_scope(agenda, scope):
+            out[scope] = kind
+    return out
 
 
 def _set_out(goal: TaskGoal, scope: str) -> bool:
