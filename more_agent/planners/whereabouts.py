@@ -149,8 +149,9 @@ def deliveries() -> tuple[Delivery, ...]:
 
 
 def _placements(goal: Any) -> list[tuple[str, str]]:
-    """(item term, destination scope) of every ``inside`` / ``ontop`` literal in a parsed goal, quantified or not."""
-    if not isinstance(goal, list) or not goal:
+    """(item term, destination scope) of every ``inside`` / ``ontop`` literal in a parsed goal, quantified or not;
+    not a negated one (what is taken out of a car says nothing of where a car's load waits)."""
+    if not isinstance(goal, list) or not goal or goal[0] == "not":
         return []
     if goal[0] in ("inside", "ontop") and len(goal) == 3 and all(isinstance(a, str) for a in goal[1:]):
         return [(goal[1], goal[2].lstrip("?"))]
@@ -162,10 +163,11 @@ def _synset(term: str) -> str:
     return re.sub(r"_\d+$", "", term.lstrip("?"))
 
 
+@cache
 def destination_share(synset: str, leave_out: str = "") -> float | None:
     """The share of the items that other activities' goals put into or onto furniture of ``synset`` which start
-    in its room, each activity weighing one (bddl 3.6: a car 0.85 over 20 activities, a cabinet 0.90, a fridge
-    0.83, a breakfast table 0.61); None with fewer than ``DELIVERY_ACTIVITIES`` activities."""
+    in its room, each activity weighing one (bddl 3.6: a car 0.80 over 15 activities, a cabinet 0.90, a fridge
+    0.82, a breakfast table 0.61); None with fewer than ``DELIVERY_ACTIVITIES`` activities."""
     per_activity: dict[str, list[bool]] = {}
     for d in deliveries():
         if d.destination == synset and d.activity != leave_out:
