@@ -80,8 +80,11 @@ the inventory), sorted. The LLM's room classifier chooses from them."""
 
 
 def scope_synset(scope: str) -> str:
-    """The synset of a bddl scope: 'apple.n.01_1' -> 'apple.n.01' (a '?' of a quantified variable dropped)."""
-    return scope.lstrip("?").rsplit("_", 1)[0]
+    """The synset of a bddl scope or goal term: 'apple.n.01_1' -> 'apple.n.01', 'cabinet.n.01_*' -> 'cabinet.n.01';
+    a '?' dropped, and a quantified variable ('?bottle__of__catsup.n.01', no instance suffix) is its synset already."""
+    term = scope.lstrip("?")
+    head, _, suffix = term.rpartition("_")
+    return head if head and "." not in suffix else term
 
 
 def room_type(room_id: str) -> str:

@@ -17,7 +17,6 @@ second), on first use.
 
 from __future__ import annotations
 
-import re
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -131,10 +130,7 @@ def deliveries() -> tuple[Delivery, ...]:
     its suitcases wait, a cabinet's dishes start in its kitchen, a breakfast table's plates often in the kitchen
     next door (:func:`destination_share`)."""
     found = []
-    evidence_of: dict[str, dict[str, list[Evidence]]] = {}
-    for synset, evs in corpus().items():
-        for e in evs:
-            evidence_of.setdefault(e.activity, {}).setdefault(synset, []).append(e)
+    evidence_of = _by_activity()
     for name in catalog.activity_names():
         _, init, goal = catalog.activity_problem(name)
         rooms = {lit[1]: lit[2] for lit in init if lit and lit[0] == "inroom" and len(lit) == 3}
@@ -142,9 +138,9 @@ def deliveries() -> tuple[Delivery, ...]:
             room = rooms.get(furniture)
             if room is None:
                 continue
-            for e in evidence_of.get(name, {}).get(_synset(item), []):
+            for e in evidence_of.get(name, {}).get(scope_synset(item), []):
                 if e.room_type:
-                    found.append(Delivery(name, _synset(furniture), e.room_type == room))
+                    found.append(Delivery(name, scope_synset(furniture), e.room_type == room))
     return tuple(found)
 
 
@@ -156,11 +152,6 @@ def _placements(goal: Any) -> list[tuple[str, str]]:
     if goal[0] in ("inside", "ontop") and len(goal) == 3 and all(isinstance(a, str) for a in goal[1:]):
         return [(goal[1], goal[2].lstrip("?"))]
     return [pair for part in goal if isinstance(part, list) for pair in _placements(part)]
-
-
-def _synset(term: str) -> str:
-    """The synset of a goal term: a scope (``?apple.n.01_1``) or a quantified variable (``?apple.n.01``)."""
-    return re.sub(r"_\d+$", "", term.lstrip("?"))
 
 
 @cache
@@ -178,16 +169,22 @@ def destination_share(synset: str, leave_out: str = "") -> float | None:
 
 
 @cache
+def _by_activity() -> dict[str, dict[str, list[Evidence]]]:
+    """Activity -> item synset -> the evidence it gives (the corpus regrouped by activity)."""
+    grouped: dict[str, dict[str, list[Evidence]]] = {}
+    for synset, evs in corpus().items():
+        for e in evs:
+            grouped.setdefault(e.activity, {}).setdefault(synset, []).append(e)
+    return grouped
+
+
+@cache
 def together_share() -> float:
     """How often two items one activity places share a room type, over the pairs of distinct item synsets
     of every activity (0.98 in bddl 3.6: 955 of its 1016 activities place every item in one room type): a
     task's objects are set out together, so one found tells where the others are."""
-    rooms: dict[str, dict[str, set[str]]] = {}  # activity -> item synset -> room types
-    for synset, evs in corpus().items():
-        for e in evs:
-            if e.room_type:
-                rooms.setdefault(e.activity, {}).setdefault(synset, set()).add(e.room_type)
-    pairs = [bool(a & b) for items in rooms.values() for a, b in combinations(items.values(), 2)]
+    rooms = [[{e.room_type for e in evs if e.room_type} for evs in items.values()] for items in _by_activity().values()]
+    pairs = [bool(a & b) for items in rooms for a, b in combinations([r for r in items if r], 2)]
     return sum(pairs) / len(pairs)
 
 
