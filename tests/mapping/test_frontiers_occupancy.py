@@ -130,16 +130,25 @@ def test_bev_ignores_lintels_and_keeps_negative_tops() -> None:
 
 def test_instance_voxels_groups_every_instance_voxel_in_grid_order() -> None:
     """The compiled pass of instance_voxels keeps numpy's selection: voxels with an instance id and a
-    class, in flat grid order; on a view into a larger buffer too (how the voxel map holds its grid)."""
+    class, in flat grid order, in the marked columns (those ever given an instance voxel), of one id when
+    asked; on a view into a larger buffer too (how the voxel map holds its grid)."""
     from more_agent.mapping.occupancy import _instance_cells
 
     rng = np.random.default_rng(1)
     cls = rng.integers(0, 3, (9, 7, 5)).astype(np.uint16)
     inst = rng.integers(-1, 4, (9, 7, 5)).astype(np.int32)
-    flat, ids = _instance_cells(cls, inst)
+    every = np.ones(cls.shape[:2], dtype=np.bool_)
+    flat, ids = _instance_cells(cls, inst, every, 0)
     expected = np.flatnonzero((inst > 0) & (cls > 0))
     assert np.array_equal(flat, expected) and np.array_equal(ids, inst.ravel()[expected])
     flat, ids = _instance_cells(
-        np.pad(cls, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3], np.pad(inst, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3]
+        np.pad(cls, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3],
+        np.pad(inst, ((2, 1), (0, 3), (0, 0)))[2:-1, :-3],
+        np.pad(every, ((2, 1), (0, 3)))[2:-1, :-3],
+        0,
     )
     assert np.array_equal(flat, expected) and np.array_equal(ids, inst.ravel()[expected])
+    some = rng.random(every.shape) < 0.5
+    flat, ids = _instance_cells(cls, inst, some, 2)
+    expected = np.flatnonzero((inst == 2) & (cls > 0) & some[:, :, None])
+    assert np.array_equal(flat, expected) and (ids == 2).all() and expected.size > 0
