@@ -13,7 +13,6 @@ shortest path on that grid from the start to the nearest such pose.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -53,15 +52,19 @@ class StartFacts:
 
 def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[tuple[int, int]]:
     """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
-    cells = []
+    cells: list[tuple[int, int]] = []
     for t in targets:
         x0, y0, x1, y1 = reach_box(world, t)
         for poses in candidate_poses(world, t):
-            cells += [
-                grid.cell_at(x, y)
-                for x, y in poses
-                if math.hypot(max(x0 - x, 0.0, x - x1), max(y0 - y, 0.0, y - y1)) <= REACH_M and grid.is_free(x, y)
-            ]
+            xy = np.asarray(poses, dtype=float).reshape(-1, 2)  # a garden's floor: thousands of poses
+            x, y = xy[:, 0], xy[:, 1]
+            gap = np.hypot(np.maximum(np.maximum(x0 - x, 0.0), x - x1), np.maximum(np.maximum(y0 - y, 0.0), y - y1))
+            ix, iy = grid.cell_of(xy).T
+            inside = (ix >= 0) & (ix < grid.shape[0]) & (iy >= 0) & (iy < grid.shape[1])
+            ok = np.zeros(len(xy), dtype=bool)
+            ok[inside] = grid.free[ix[inside], iy[inside]]
+            ok &= gap <= REACH_M
+            cells += [(int(i), int(j)) for i, j in zip(ix[ok], iy[ok])]
     return cells
 
 
