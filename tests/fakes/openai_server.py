@@ -184,6 +184,9 @@ class FakeOpenAIServer:
 
 class _Handler(BaseHTTPRequestHandler):
     protocol_version = "HTTP/1.1"
+    disable_nagle_algorithm = True
+    """Headers and body go out as two writes: with Nagle's algorithm the body waits for the client's
+    delayed ACK of the headers, 40 ms a response on Linux (a test episode of 50 requests waited 2 s)."""
     fake: FakeOpenAIServer
 
     def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - stdlib signature
