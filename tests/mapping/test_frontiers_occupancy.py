@@ -1,6 +1,7 @@
 """Frontier clusters and the voxel map -> BEV update."""
 
 import numpy as np
+import pytest
 
 from more_agent.mapping import Grid, VoxelMap, depth_to_points, frontier_points, visible_unknown_area
 from more_agent.mapping.occupancy import FREE, OCCUPIED, UNKNOWN, zeroed
@@ -83,6 +84,8 @@ def test_grid_grows_and_keeps_content_and_ignored_instances_are_not_mapped() -> 
     assert 9 in vmap.instance_voxels()
     vmap.clear_instance(9)
     assert 9 not in vmap.instance_voxels()
+    with pytest.raises(ValueError, match="instance ids are positive"):
+        vmap.clear_instance(0)  # would have cleared every voxel of no object: floor, walls
 
 
 def test_growth_in_every_direction_keeps_the_map_and_brings_in_only_unknown_cells() -> None:
