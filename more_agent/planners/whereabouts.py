@@ -11,8 +11,8 @@ inside).
 The evidence of the activity being played is left out (leave-one-out: a planner never reads its own
 task's initial state). A synset with too little evidence of its own borrows its parent's in the
 taxonomy (every synset the corpus places under it), up to ``MAX_LEVELS`` generations up; beyond that
-there is no prior and the search ranks as it would without one. Parsed once per process (about a
-second), on first use.
+there is no prior and the search ranks as it would without one. Parsed once per process on first use,
+taxonomy included (about 0.5 s on the 2-core machine of docs/benchmarks.md, 2026-12-06).
 """
 
 from __future__ import annotations
@@ -57,12 +57,17 @@ class Evidence:
 
 
 @cache
+def _problems() -> tuple[tuple[str, list[Any], list[Any]], ...]:
+    """(activity, init, goal) of every bddl activity, parsed once for the corpus and the deliveries alike."""
+    return tuple((name, *catalog.activity_problem(name)[1:]) for name in catalog.activity_names())
+
+
+@cache
 def corpus() -> dict[str, tuple[Evidence, ...]]:
     """Item synset -> its evidence over every bddl activity (read with bddl's own parser: static knowledge
     of the library, not the episode's task, which planners may not import)."""
     found: dict[str, list[Evidence]] = {}
-    for name in catalog.activity_names():
-        init = catalog.activity_problem(name)[1]
+    for name, init, _ in _problems():
         for synset, ev in _activity_evidence(name, init):
             found.setdefault(synset, []).append(ev)
     return {s: tuple(evs) for s, evs in found.items()}
@@ -131,8 +136,7 @@ def deliveries() -> tuple[Delivery, ...]:
     next door (:func:`destination_share`)."""
     found = []
     evidence_of = _by_activity()
-    for name in catalog.activity_names():
-        _, init, goal = catalog.activity_problem(name)
+    for name, init, goal in _problems():
         rooms = {lit[1]: lit[2] for lit in init if lit and lit[0] == "inroom" and len(lit) == 3}
         for item, furniture in _placements(goal):
             room = rooms.get(furniture)

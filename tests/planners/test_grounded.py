@@ -217,26 +217,13 @@ def test_explore_goes_to_the_frontiers_far_from_the_robots_path() -> None:
     assert far_frontiers([], path) == ()
 
 
-def test_explore_goes_to_the_frontiers_with_the_most_unseen_floor_in_range() -> None:
-    import numpy as np
-
-    from more_agent.mapping import FREE, UNKNOWN
-    from more_agent.scene_graph import OccupancyMap
-
-    sit = planner_in(fresh_kitchen()).situation()
-    cells = np.full((400, 200), FREE, dtype=np.int8)  # 40 m x 20 m at 0.1 m, corner at the origin
-    cells[300:, :] = UNKNOWN  # a large unseen area east of x = 30 m
-    cells[:20, 95:105] = UNKNOWN  # a nook at the west edge, nearly seen
-    occupancy = OccupancyMap(grid=cells, origin_xy=(0.0, 0.0), resolution_m=0.1)
-    sit = replace(sit, graph=sit.graph.model_copy(update={"occupancy": occupancy}))
-    nook, open_edge, beside = (2.1, 10.0), (29.9, 10.0), (29.9, 2.0)
-    assert informative(sit, (nook, open_edge, beside)) == (open_edge, beside)
-    assert informative(sit, (nook,)) == (nook,)  # a single frontier is kept whatever it shows
+NOOK, OPEN_EDGE, BESIDE = (2.1, 10.0), (29.9, 10.0), (29.9, 2.0)
+"""Frontiers of :func:`_open_field`: a nook nearly seen at its west edge, two facing the unseen east."""
 
 
-def test_explore_heads_for_unseen_floor_before_a_pocket_far_from_the_path() -> None:
-    """A pocket far from where the robot went loses to frontiers facing open unseen floor near its path
-    (bringing_newspaper_in seed 1 spent its garden's explores on pockets and never saw its far end)."""
+def _open_field() -> Situation:
+    """The kitchen planner's situation on a 40 m x 20 m map (0.1 m cells, corner at the origin), free but
+    for a large unseen area east of x = 30 m and a nook at the west edge, nearly seen."""
     import numpy as np
 
     from more_agent.mapping import FREE, UNKNOWN
@@ -244,21 +231,32 @@ def test_explore_heads_for_unseen_floor_before_a_pocket_far_from_the_path() -> N
 
     sit = planner_in(fresh_kitchen()).situation()
     cells = np.full((400, 200), FREE, dtype=np.int8)
-    cells[300:, :] = UNKNOWN  # open unseen floor east of x = 30 m
-    cells[:20, 95:105] = UNKNOWN  # a pocket at the west edge, far from the path
+    cells[300:, :] = UNKNOWN
+    cells[:20, 95:105] = UNKNOWN
     occupancy = OccupancyMap(grid=cells, origin_xy=(0.0, 0.0), resolution_m=0.1)
-    pocket, open_edge, beside = (2.1, 10.0), (29.9, 10.0), (29.9, 2.0)
+    return replace(sit, graph=sit.graph.model_copy(update={"occupancy": occupancy}))
+
+
+def test_explore_goes_to_the_frontiers_with_the_most_unseen_floor_in_range() -> None:
+    sit = _open_field()
+    assert informative(sit, (NOOK, OPEN_EDGE, BESIDE)) == (OPEN_EDGE, BESIDE)
+    assert informative(sit, (NOOK,)) == (NOOK,)  # a single frontier is kept whatever it shows
+
+
+def test_explore_heads_for_unseen_floor_before_a_pocket_far_from_the_path() -> None:
+    """A pocket far from where the robot went loses to frontiers facing open unseen floor near its path
+    (bringing_newspaper_in seed 1 spent its garden's explores on pockets and never saw its far end)."""
+    sit = _open_field()
     region = next(iter(sit.graph.regions))
     regions = {
         **sit.graph.regions,
-        region: sit.graph.regions[region].model_copy(update={"frontiers": [pocket, open_edge, beside]}),
+        region: sit.graph.regions[region].model_copy(update={"frontiers": [NOOK, OPEN_EDGE, BESIDE]}),
     }
-    graph = sit.graph.model_copy(update={"occupancy": occupancy, "regions": regions})
-    sit = replace(sit, graph=graph, path=[(25.0, 10.0), (27.0, 6.0)])
-    assert far_frontiers([pocket, open_edge, beside], sit.path) == (pocket,)  # farthest from the path alone
+    sit = replace(sit, graph=sit.graph.model_copy(update={"regions": regions}), path=[(25.0, 10.0), (27.0, 6.0)])
+    assert far_frontiers([NOOK, OPEN_EDGE, BESIDE], sit.path) == (NOOK,)  # farthest from the path alone
     target = explore_step(sit, region, "looking").action.target
     assert isinstance(target, Area) and target.frontiers is not None
-    assert pocket not in target.frontiers and open_edge in target.frontiers
+    assert NOOK not in target.frontiers and OPEN_EDGE in target.frontiers
 
 
 def test_unlisted_categories_do_not_rank_rooms() -> None:
