@@ -93,6 +93,10 @@ class Observation:
     placed: Mapping[int, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     """Instance id -> box (min, max corner) of an item released since the last sensing and of what
     rode on or in it: where the robot put them, kept on the map until a frame shows them."""
+    revealed: Mapping[int, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    """Instance id -> box of each object inside what the robot just opened: paper S.2, "all inner objects
+    within an articulated object become visible to the robot once the outer object is opened", whether or
+    not the frame shows them (from beside an open carton, its rim hides a book lying at its bottom)."""
 
 
 class Robot(Protocol):

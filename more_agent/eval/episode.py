@@ -33,7 +33,7 @@ from more_agent.llm.limits import MAX_FEEDBACK_CHARS, clip
 from more_agent.planners.base import EpisodeContext, Planner, make_planner
 from more_agent.records import DEFAULT_HISTORY, ActionRecord, EpisodeRecord, EpisodeSpec, HistoryMode, WorldStats
 from more_agent.redaction import redact
-from more_agent.robot import XY
+from more_agent.robot import XY, Observation
 from more_agent.safe_files import DISK_FULL_ERRNOS
 
 if TYPE_CHECKING:
@@ -160,7 +160,8 @@ def run_episode(
             goals,
             descriptions=spec.descriptions,
             history=spec.history,
-            on_frame=bag.hook(world, instance.labels, then=on_frame) if bag is not None else on_frame,
+            on_frame=on_frame,
+            on_sensed=bag.hook(world, instance.labels) if bag is not None else None,
             trace_graphs=folder is not None and folder.graphs,
             perception=perception,
             past_failures=spec.past_failures,
@@ -214,12 +215,13 @@ def reset_planner(
     descriptions: str = "named",
     history: HistoryMode = DEFAULT_HISTORY,
     on_frame: Callable[[Frame], None] | None = None,
+    on_sensed: Callable[[Observation], None] | None = None,
     trace_graphs: bool = False,
     perception: NoisyPerception | None = None,
     past_failures: tuple[str, ...] = (),
 ) -> tuple[SimRobot, PrivilegedContext | None]:
     """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
-    gets every frame it renders; with ``perception``, the planner drives it through a
+    gets every frame it renders, ``on_sensed`` every observation of one; with ``perception``, the planner drives it through a
     :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`) and the
     ``past_failures`` of earlier trials, grant the
     world and the goal checker to a privileged planner (one with ``grant``: the oracle), then ``reset``
@@ -228,7 +230,7 @@ def reset_planner(
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import PrivilegedContext
 
-    robot = SimRobot(instance.world, labels=instance.labels, on_frame=on_frame)
+    robot = SimRobot(instance.world, labels=instance.labels, on_frame=on_frame, on_sensed=on_sensed)
     grant = getattr(planner, "grant", None)
     privileged = PrivilegedContext(world=instance.world, goals=goals) if grant is not None else None
     if grant is not None:

@@ -92,6 +92,11 @@ class LabelTable(BaseModel):
         description="Instances the robot just put down, with their box (min, max corner, metres): kept in the map "
         "while no camera sees them.",
     )
+    revealed: dict[int, tuple[tuple[float, float, float], tuple[float, float, float]]] = Field(
+        default_factory=dict,
+        description="Instances inside what the robot just opened, with their box: perceived though no camera may "
+        "see them (paper S.2: all inner objects become visible once the outer object is opened).",
+    )
 
 
 def image_array(msg: Any, topic: str, encodings: tuple[str, ...] | dict[str, Any]) -> np.ndarray:

@@ -63,6 +63,8 @@ class SensorFrame:
     """The label table's instances."""
     placed: dict[int, tuple[tuple[float, float, float], tuple[float, float, float]]]
     """Instances put down since the previous frame (a table's ``placed``, given once)."""
+    revealed: dict[int, tuple[tuple[float, float, float], tuple[float, float, float]]]
+    """Instances inside what the robot just opened (a table's ``revealed``, given once)."""
 
 
 @dataclass
@@ -249,7 +251,7 @@ class BagStream:
             self._tf.lookup(t.world_frame, t.base_frame, stamp_s) if self._tf.knows(t.base_frame) else T_world_cam
         )[:2, 3]
         index, table = self._tables.at(t_ns)
-        placed = table.placed if index != self._last_table else {}
+        fresh = index != self._last_table
         self._last_table = index
         return SensorFrame(
             stamp_s=stamp_s,
@@ -261,7 +263,8 @@ class BagStream:
             T_world_cam=T_world_cam,
             robot_xy=(float(robot[0]), float(robot[1])),
             instances=dict(table.instances),
-            placed=dict(placed),
+            placed=dict(table.placed) if fresh else {},
+            revealed=dict(table.revealed) if fresh else {},
         )
 
 

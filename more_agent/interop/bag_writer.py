@@ -11,7 +11,7 @@ perception and proprioception tell its mapping (``planners.policies.embodiment.E
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, Literal
 
@@ -33,6 +33,7 @@ from more_agent.interop.bag_contract import (
 )
 from more_agent.interop.requirement import require
 from more_agent.interop.transforms import matrix_pose, pose_matrix
+from more_agent.robot import Observation
 from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.render import Frame
 from more_agent.sim.world import World
@@ -84,9 +85,16 @@ class BagRecorder:
     def __exit__(self, *exc: object) -> None:
         self._writer.close()
 
-    def record(self, world: World, labels: InstanceLabels, frame: Frame) -> None:
+    def record(
+        self,
+        world: World,
+        labels: InstanceLabels,
+        frame: Frame,
+        revealed: Mapping[int, tuple[np.ndarray, np.ndarray]] | None = None,
+    ) -> None:
         """Write one frame rendered from ``world``'s current robot pose (before the robot's mapping fuses it),
-        its instances named by ``labels`` (the robot's)."""
+        its instances named by ``labels`` (the robot's); ``revealed``: the boxes of what lies inside what
+        the robot just opened (``Observation.revealed``)."""
         t = self.topics
         t_ns = round(self.frames * FRAME_PERIOD_S * 1e9)
         header = self._header(t_ns, CAMERA_FRAME)
@@ -94,7 +102,11 @@ class BagRecorder:
             (world.robot.x, world.robot.y, 0.0), (0.0, 0.0, np.sin(world.robot.yaw / 2), np.cos(world.robot.yaw / 2))
         )
         T_base_cam = np.linalg.inv(T_world_base) @ frame.T_world_cam
-        self._write(t.labels, t_ns, self._msg(STRING, data=self._label_table(world, labels, frame).model_dump_json()))
+        self._write(
+            t.labels,
+            t_ns,
+            self._msg(STRING, data=self._label_table(world, labels, frame, revealed or {}).model_dump_json()),
+        )
         # the head pans and tilts (Robot.sense's head pose), so base -> camera is a moving joint as on a
         # real Fetch: on /tf with every frame, beside map -> base, rather than once on /tf_static
         tf = self._tf(t_ns, (t.world_frame, t.base_frame, T_world_base), (t.base_frame, CAMERA_FRAME, T_base_cam))
@@ -122,22 +134,22 @@ class BagRecorder:
             self._write(topic, t_ns, self._msg(IMAGE, header=header, **image_fields(pixels, encoding)))
         self.frames += 1
 
-    def hook(
-        self, world: World, labels: InstanceLabels, *, then: Callable[[Frame], None] | None = None
-    ) -> Callable[[Frame], None]:
-        """An ``on_frame`` hook recording each frame of ``world`` with ``labels``, then calling ``then`` (another hook)."""
+    def hook(self, world: World, labels: InstanceLabels) -> Callable[[Observation], None]:
+        """An ``on_sensed`` hook (``SimRobot``) recording each sensing of ``world``, its instances named by
+        ``labels`` (the robot's), with what the robot was told of the inside of what it just opened."""
 
-        def on_frame(frame: Frame) -> None:
-            self.record(world, labels, frame)
-            if then is not None:
-                then(frame)
+        def on_sensed(seen: Observation) -> None:
+            self.record(world, labels, seen.frame, revealed=seen.revealed)
 
-        return on_frame
+        return on_sensed
 
     # -- the label table ----------------------------------------------------------------------------
-    def _label_table(self, world: World, labels: InstanceLabels, frame: Frame) -> LabelTable:
+    def _label_table(
+        self, world: World, labels: InstanceLabels, frame: Frame, revealed: Mapping[int, tuple[np.ndarray, np.ndarray]]
+    ) -> LabelTable:
         """Instances in view, the held one, those whose open state changed out of view (the robot just
-        opened / closed them) and the item just put down, with its box."""
+        opened / closed them), the item just put down, with its box, and what lies inside what was just
+        opened, with theirs."""
         entries = {
             iid: InstanceLabel(
                 category=d["category"],
@@ -162,7 +174,7 @@ class BagRecorder:
             for rider in [put_down, *world.descendants(released)]:
                 lo, hi = rider.box()
                 placed[rider.instance_id] = (tuple(map(float, lo)), tuple(map(float, hi)))
-        for iid in changed:
+        for iid in [*changed, *revealed]:
             obj = by_id[iid]
             entries.setdefault(
                 iid,
@@ -176,7 +188,8 @@ class BagRecorder:
             )
         self._held = world.robot.held
         self._reported_open.update({iid: e.open for iid, e in entries.items()})
-        return LabelTable(classes=list(world.class_names), instances=entries, placed=placed)
+        inside = {iid: (tuple(map(float, lo)), tuple(map(float, hi))) for iid, (lo, hi) in revealed.items()}
+        return LabelTable(classes=list(world.class_names), instances=entries, placed=placed, revealed=inside)
 
     # -- messages -----------------------------------------------------------------------------------
     def _write(self, topic: str, t_ns: int, msg: Any) -> None:

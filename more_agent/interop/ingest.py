@@ -44,8 +44,9 @@ class FrameMapper:
         self._per_category: dict[str, int] = {}
 
     def add(self, frame: SensorFrame) -> None:
-        """Fuse one frame (the items it reports as put down are kept at their boxes first)."""
-        for iid, (lo, hi) in frame.placed.items():
+        """Fuse one frame (the items it reports as put down, or inside what was just opened, are kept at
+        their boxes first)."""
+        for iid, (lo, hi) in [*frame.placed.items(), *frame.revealed.items()]:
             self.builder.remember(iid, lo, hi)
         infos = {iid: self._info(iid, entry) for iid, entry in frame.instances.items()}
         for iid in np.unique(frame.instance[frame.instance > 0]).tolist():

@@ -51,9 +51,9 @@ class NoisyRobot:
         self._drive_odometry()
         real = [self.noise.real_label(label) for label in acted_on]
         seen = self.inner.sense(real, head=head)
-        known = {i for i, info in seen.instances.items() if info.held or info.label in real} | set(seen.placed)
-        frame, instances = self.noise.observe(seen.frame, seen.instances, known)
-        return Observation(frame=frame, instances=instances, placed=seen.placed)
+        known = {i for i, info in seen.instances.items() if info.held or info.label in real}
+        frame, instances = self.noise.observe(seen.frame, seen.instances, known | set(seen.placed) | set(seen.revealed))
+        return Observation(frame=frame, instances=instances, placed=seen.placed, revealed=seen.revealed)
 
     def _drive_odometry(self) -> None:
         """Drift for every stretch driven since the last sensing, in order."""

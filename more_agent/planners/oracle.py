@@ -331,7 +331,7 @@ class OraclePlanner:
         if result.ok:
             self._observed.add(arg)
             if action.name == "go_to_and_open":
-                self._observed.update(o.name for o in world.descendants(arg) if world.is_observable(o.name))
+                self._observed.update(o.name for o in world.shown_by_opening(arg))
         else:
             key = (action.name, action.arguments)
             # A different failure (another reason, another door in the way, even one not yet seen)

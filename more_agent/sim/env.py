@@ -415,16 +415,17 @@ class SimRobot:
         labels: InstanceLabels | None = None,
         renderer: Renderer | None = None,
         on_frame: Callable[[Frame], None] | None = None,
+        on_sensed: Callable[[Observation], None] | None = None,
     ) -> None:
         """``labels``: what the robot calls objects (the task instance's, with those its description names
         reserved; else afresh); ``on_frame`` is called with every rendered frame (the episode folder
-        writes them)."""
+        writes them), ``on_sensed`` with every observation made of one (a bag recorder writes them)."""
         self._world = world
         self._labels = labels if labels is not None else InstanceLabels()
         self._env = MoreAgentEnv(sensors=False, max_steps=None)
         self._env.reset(options={"world": world, "labels": self._labels})
         self._renderer = renderer or Renderer()
-        self._on_frame = on_frame
+        self._on_frame, self._on_sensed = on_frame, on_sensed
         self._held: str | None = None
         """The held item at the last sensing (to report one released since)."""
         self._steps = 0
@@ -461,8 +462,9 @@ class SimRobot:
         The robot knows what it did: an item released since the last frame is reported as no longer
         held, resting where it was put, even when no camera sees it (``Observation.placed`` keeps it,
         and what rode on or in it, at their boxes), and the objects in ``acted_on`` are reported with
-        their new state even when out of view. ``head`` (pan left, tilt down; radians) renders from the
-        head pointed away from its driving pose.
+        their new state even when out of view, what lies inside those that are open with them
+        (``Observation.revealed``). ``head`` (pan left, tilt down; radians) renders from the head pointed
+        away from its driving pose.
         """
         world = self._world
         if head is None:
@@ -482,24 +484,30 @@ class SimRobot:
         }
         released = self._held if self._held is not None and self._held != world.robot.held else None
         acted = [name for name in map(self._env.resolve, acted_on) if name is not None]
-        for name in [*acted, *([released] if released is not None else [])]:
-            obj = world.get(name)
+        inner = [obj for name in acted for obj in world.shown_by_opening(name)]
+        self._labels.observe(inner)
+        for obj in [*map(world.get, acted), *([world.get(released)] if released is not None else []), *inner]:
             infos.setdefault(
                 obj.instance_id,
                 InstanceInfo(
-                    label=self._labels.label(name),
+                    label=self._labels.label(obj.name),
                     category=obj.category,
                     open=obj.is_open if obj.openable else None,
-                    held=world.robot.held == name,
-                    rests=self._rests(name),
+                    held=world.robot.held == obj.name,
+                    rests=self._rests(obj.name),
                 ),
             )
         placed = {}
         if released is not None:  # with what rode on it
             placed = {obj.instance_id: obj.box() for obj in [world.get(released), *world.descendants(released)]}
         self._held = world.robot.held
-        self.observed.update(d["name"] for d in table.values())
-        return Observation(frame=frame, instances=infos, placed=placed)
+        self.observed.update([*(d["name"] for d in table.values()), *(obj.name for obj in inner)])
+        seen = Observation(
+            frame=frame, instances=infos, placed=placed, revealed={obj.instance_id: obj.box() for obj in inner}
+        )
+        if self._on_sensed is not None:
+            self._on_sensed(seen)
+        return seen
 
     def _rests(self, name: str) -> tuple[Relation, str | None] | None:
         """How a seen object rests, as perception reports it: the world's support link (what the last

@@ -170,6 +170,15 @@ class World:
             return False
         return self.enclosing_closed_container(name) is None
 
+    def shown_by_opening(self, name: str) -> list[WorldObject]:
+        """What an open ``name`` shows the robot that opened it: the observable objects inside it, depth
+        first (paper S.2: "all inner objects within an articulated object become visible to the robot once
+        the outer object is opened"); nothing while it is closed or cannot open."""
+        obj = self.get(name)
+        if not (obj.openable and obj.is_open):
+            return []
+        return [o for o in self.descendants(name) if self.is_inside(o.name, name) and self.is_observable(o.name)]
+
     def room_at(self, x: float, y: float) -> str | None:
         """The room whose footprint contains (x, y), if any."""
         for room in self.scene.rooms:

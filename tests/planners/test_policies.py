@@ -31,7 +31,9 @@ from more_agent.records import FailureReason
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.scene import load_scene
+from tests.sim.test_navgrid import two_room_world
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -391,3 +393,20 @@ def test_within_answers_like_the_whole_grids_distance_transform() -> None:
         whole = ndimage.distance_transform_edt(~occupied) * 0.075 > radius
         cropped = ~_within(occupied, radius, 0.075, around=known if occupied.any() else None)
         assert np.array_equal(known & whole, known & cropped), trial
+
+
+def test_what_opening_reveals_joins_the_map_unseen() -> None:
+    """The contents of what the robot opened (``Observation.revealed``) are in its scene graph and count as
+    observed though no frame showed them: the camera looks away from the fridge."""
+    world = two_room_world()
+    labels = InstanceLabels()
+    labels.reserve(world.get("fridge_0"))
+    body = Embodiment(SimRobot(world, labels=labels))
+    body.start()
+    assert body.act("open", "fridge A").ok
+    x, y, yaw = body.robot.pose
+    world.set_robot_pose(x, y, yaw + math.pi)
+    body.sense(acted_on=("fridge A",))
+    apple = body.build().objects["apple A"]
+    assert apple.category == "apple" and world.get("apple_0").instance_id in body.observed
+    assert np.allclose(apple.position, world.get("apple_0").center, atol=0.05)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from more_agent.sim.actions import (
@@ -139,3 +140,27 @@ def test_turn_steps(turn, expected):
 
 def test_forward_steps():
     assert count_low_level_steps(0.0, [(0.0, 0.0), (0.75, 0.0)], 0.0) == 10
+
+
+def test_opening_a_container_reveals_what_lies_inside_even_out_of_the_frame():
+    """Paper S.2: "all inner objects within an articulated object become visible to the robot once the
+    outer object is opened". From beside an open carton its rim can hide a book at its bottom: the robot
+    that opened it is told of its contents whether or not the frame shows them, and only while it is open."""
+    world = two_room_world()
+    labels = InstanceLabels()
+    labels.reserve(world.get("fridge_0"))
+    robot = SimRobot(world, labels=labels)
+    apple = world.get("apple_0").instance_id
+    assert robot.sense(["fridge A"]).revealed == {}  # closed: nothing inside shows
+    assert robot.act("open", "fridge A").ok
+    x, y, yaw = robot.pose
+    world.set_robot_pose(x, y, yaw + math.pi)  # the camera turned away from the fridge
+    seen = robot.sense(["fridge A"])
+    assert apple not in seen.frame.instance
+    lo, hi = seen.revealed[apple]
+    assert np.allclose(lo, world.get("apple_0").box()[0]) and np.allclose(hi, world.get("apple_0").box()[1])
+    info = seen.instances[apple]
+    assert (info.label, info.category, info.rests) == ("apple A", "apple", ("inside", "fridge A"))
+    assert robot.sense().revealed == {}  # told once, with the action; frames show the rest
+    assert robot.act("close", "fridge A").ok
+    assert robot.sense(["fridge A"]).revealed == {}

@@ -139,13 +139,13 @@ class Embodiment:
         seen = self.robot.sense(acted_on, head=head)
         if self.on_frame is not None:
             self.on_frame(seen.frame)
-        for instance_id, box in seen.placed.items():
+        for instance_id, box in [*seen.placed.items(), *seen.revealed.items()]:
             self.builder.remember(instance_id, *box)
         frame = seen.frame
         self.builder.integrate(
             frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, seen.instances, self.xy
         )
-        self.observed.update(np.flatnonzero(np.bincount(frame.instance.ravel())).tolist())
+        self.observed.update([*np.flatnonzero(np.bincount(frame.instance.ravel())).tolist(), *seen.revealed])
         if self.robot.held is not None:
             self.observed.add(self.robot.held)
         self.observed.discard(0)
