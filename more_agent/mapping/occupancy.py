@@ -326,7 +326,8 @@ class VoxelMap:
             res,
             r,
         )
-        _update_top(self.cls, self.top_class, *changed, self._top_level)  # the columns whose classes changed
+        x0, x1, y0, y1 = changed.tolist()  # the columns whose classes changed
+        _update_top(self.cls, self.top_class, x0, x1, y0, y1, self._top_level)
 
     def occupancy(self) -> np.ndarray:
         """BEV grid (int8): UNKNOWN, FREE (top voxel of a free-space class) or OCCUPIED."""
