@@ -96,7 +96,8 @@ class Observation:
     revealed: Mapping[int, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     """Instance id -> box of each object inside what the robot just opened: paper S.2, "all inner objects
     within an articulated object become visible to the robot once the outer object is opened", whether or
-    not the frame shows them (from beside an open carton, its rim hides a book lying at its bottom)."""
+    not the frame shows them (the simulator's open container keeps a top slab, which hides a book at the
+    bottom of a carton from the steep look of a robot standing beside it)."""
 
 
 class Robot(Protocol):

@@ -221,11 +221,11 @@ def reset_planner(
     past_failures: tuple[str, ...] = (),
 ) -> tuple[SimRobot, PrivilegedContext | None]:
     """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
-    gets every frame it renders, ``on_sensed`` every observation of one; with ``perception``, the planner drives it through a
-    :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task (:func:`goal_spec`) and the
-    ``past_failures`` of earlier trials, grant the
-    world and the goal checker to a privileged planner (one with ``grant``: the oracle), then ``reset``
-    it. Returns the simulator's robot and the privileged context (None for any other planner)."""
+    gets every frame it renders, ``on_sensed`` every observation of one; with ``perception``, the planner
+    drives it through a :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task
+    (:func:`goal_spec`) and the ``past_failures`` of earlier trials, grant the world and the goal checker
+    to a privileged planner (one with ``grant``: the oracle), then ``reset`` it. Returns the simulator's
+    robot and the privileged context (None for any other planner)."""
     from more_agent.perception.robot import NoisyRobot
     from more_agent.sim.env import SimRobot
     from more_agent.sim.goals import PrivilegedContext

@@ -76,10 +76,11 @@ def _widen(box, ix, iy):
 @numba.njit(cache=True)
 def _carve(depth, intr, rot, trans, cls, changed, origin, res, max_range, stride, free_lut):
     """Clear the non-free-space voxels that rays pass through (sampled every ``res``) before
-    their hit (or max range), widening ``changed`` (:func:`_widen`) over their columns. Each voxel index is monotone along a ray, so a ray that has left the
-    grid never comes back: its march stops there. A sample ``res`` further along a unit direction lies
-    one voxel of that direction further: its voxel coordinates are summed, not divided out per sample
-    (a third of a frame's mapping; the maps of two recorded episodes, 1,038 frames, byte-identical)."""
+    their hit (or max range), widening ``changed`` (:func:`_widen`) over their columns. Each voxel index
+    is monotone along a ray, so a ray that has left the grid never comes back: its march stops there. A
+    sample ``res`` further along a unit direction lies one voxel of that direction further: its voxel
+    coordinates are summed, not divided out per sample (a third of a frame's mapping; the maps of two
+    recorded episodes, 1,038 frames, byte-identical)."""
     h, w = depth.shape
     nx, ny, nz = cls.shape
     x0, y0, z0 = (trans[0] - origin[0]) / res, (trans[1] - origin[1]) / res, (trans[2] - origin[2]) / res
