@@ -96,17 +96,25 @@ class NoisyPerception:
         """Instances that were in view / perceived as themselves at least once."""
 
     def observe(
-        self, frame: Frame, instances: Mapping[int, InstanceInfo], known: Iterable[int] = ()
+        self,
+        frame: Frame,
+        instances: Mapping[int, InstanceInfo],
+        known: Iterable[int] = (),
+        told: Iterable[int] = (),
     ) -> tuple[Frame, dict[int, InstanceInfo]]:
         """A ground-truth frame and what perception says of its instances as this perception reports them:
         noisy depth, perturbed semantic and instance images, the camera pose its odometry believes in;
         missed and merged instances dropped (unless ``known``: held, just acted on or released, which the
-        robot knows without a camera), the rest named as seen."""
+        robot knows without a camera), the rest named as seen. ``told`` (among ``known``): what the robot
+        learns of without a camera (what opening showed, ``Observation.revealed``) counts as in view and, unless
+        confused, as perceived (:meth:`observed`)."""
         found = perturb_instances(
             frame.depth, frame.semantic, frame.instance, float(frame.K[0, 0]), self.tables, self.spec.miss, self.rng
         )
-        self.in_view |= found.in_view
-        self.perceived |= found.kept & ~self.tables.confused
+        shown = np.zeros_like(found.in_view)
+        shown[np.fromiter(told, dtype=np.int64)] = True
+        self.in_view |= found.in_view | shown
+        self.perceived |= (found.kept | shown) & ~self.tables.confused
         hidden = set(np.flatnonzero(found.in_view & ~found.kept).tolist()) - set(known) - {0}
         infos = {i: info for i, info in instances.items() if i not in hidden}
         seen = replace(

@@ -52,7 +52,9 @@ class NoisyRobot:
         real = [self.noise.real_label(label) for label in acted_on]
         seen = self.inner.sense(real, head=head)
         known = {i for i, info in seen.instances.items() if info.held or info.label in real}
-        frame, instances = self.noise.observe(seen.frame, seen.instances, known | set(seen.placed) | set(seen.revealed))
+        frame, instances = self.noise.observe(
+            seen.frame, seen.instances, known | set(seen.placed) | set(seen.revealed), told=seen.revealed
+        )
         return Observation(frame=frame, instances=instances, placed=seen.placed, revealed=seen.revealed)
 
     def _drive_odometry(self) -> None:

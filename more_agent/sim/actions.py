@@ -19,7 +19,7 @@ steps as 7.5 cm forward moves and turns of at most 35 degrees, and ends facing t
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from more_agent.records import FailureReason
 from more_agent.robot import ActionResult
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT
 from more_agent.sim.labels import InstanceLabels
-from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, blocking_door, nav_grid, shortest_path
+from more_agent.sim.navgrid import DEFAULT_NAV, XY, NavConfig, NavGrid, blocking_door, nav_grid, shortest_path
 from more_agent.sim.world import World, WorldObject
 
 REACH_M = ROBOT.reach_m
@@ -160,10 +160,19 @@ def approach_rounds(world: World, name: str, config: NavConfig = DEFAULT_NAV) ->
     grid = nav_grid(world, config)
     box = reach_box(world, name)
     rounds = [
-        [p for p in poses if _point_to_box(p, box) <= REACH_M and grid.is_free(*p)]
-        for poses in candidate_poses(world, name)
+        [(float(x), float(y)) for x, y in within_reach(poses, box, grid)] for poses in candidate_poses(world, name)
     ]
     return [r for r in rounds if r]
+
+
+def within_reach(poses: Sequence[XY], box: tuple[float, float, float, float], grid: NavGrid) -> np.ndarray:
+    """Of ``poses``, in order (k x 2), those where the base may stand on ``grid`` with ``box`` (a
+    :func:`reach_box`) within ``REACH_M``: all at once, a garden's floor gives thousands."""
+    xy = np.asarray(poses, dtype=float).reshape(-1, 2)
+    x, y = xy.T
+    x0, y0, x1, y1 = box
+    gap = np.hypot(np.maximum(np.maximum(x0 - x, 0.0), x - x1), np.maximum(np.maximum(y0 - y, 0.0), y - y1))
+    return xy[(gap <= REACH_M) & grid.free_at(xy)]
 
 
 def navigate_to(world: World, name: str, labels: InstanceLabels, config: NavConfig = DEFAULT_NAV) -> ActionResult:

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
@@ -51,8 +52,15 @@ class NavGrid(Grid):
 
     def is_free(self, x: float, y: float) -> bool:
         """Whether the robot base may stand at (x, y)."""
-        ix, iy = self.cell_of((x, y))
-        return bool(0 <= ix < self.shape[0] and 0 <= iy < self.shape[1] and self.free[ix, iy])
+        return bool(self.free_at([(x, y)])[0])
+
+    def free_at(self, xy: ArrayLike) -> np.ndarray:
+        """Per point of ``xy`` (n x 2), whether the robot base may stand there (off the grid: no)."""
+        ix, iy = self.cell_of(np.asarray(xy, dtype=float).reshape(-1, 2)).T
+        inside = (ix >= 0) & (ix < self.shape[0]) & (iy >= 0) & (iy < self.shape[1])
+        ok = np.zeros(len(ix), dtype=bool)
+        ok[inside] = self.free[ix[inside], iy[inside]]
+        return ok
 
     @cached_property
     def _nearest_free(self) -> tuple[np.ndarray, np.ndarray]:

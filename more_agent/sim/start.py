@@ -20,7 +20,7 @@ import numpy as np
 from scipy import ndimage
 
 from more_agent.errors import UserError
-from more_agent.sim.actions import REACH_M, candidate_poses, reach_box
+from more_agent.sim.actions import candidate_poses, reach_box, within_reach
 from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M
 from more_agent.sim.navgrid import NavGrid, free_cells, nav_grid, shortest_path
 from more_agent.sim.world import World
@@ -54,17 +54,9 @@ def approach_cells(world: World, grid: NavGrid, targets: Iterable[str]) -> list[
     """Free cells of ``grid`` at the base poses the magic actions would use to reach any target."""
     cells: list[tuple[int, int]] = []
     for t in targets:
-        x0, y0, x1, y1 = reach_box(world, t)
+        box = reach_box(world, t)
         for poses in candidate_poses(world, t):
-            xy = np.asarray(poses, dtype=float).reshape(-1, 2)  # a garden's floor: thousands of poses
-            x, y = xy[:, 0], xy[:, 1]
-            gap = np.hypot(np.maximum(np.maximum(x0 - x, 0.0), x - x1), np.maximum(np.maximum(y0 - y, 0.0), y - y1))
-            ix, iy = grid.cell_of(xy).T
-            inside = (ix >= 0) & (ix < grid.shape[0]) & (iy >= 0) & (iy < grid.shape[1])
-            ok = np.zeros(len(xy), dtype=bool)
-            ok[inside] = grid.free[ix[inside], iy[inside]]
-            ok &= gap <= REACH_M
-            cells += [(int(i), int(j)) for i, j in zip(ix[ok], iy[ok])]
+            cells += [(int(i), int(j)) for i, j in grid.cell_of(within_reach(poses, box, grid))]
     return cells
 
 

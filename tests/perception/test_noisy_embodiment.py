@@ -104,3 +104,25 @@ def test_the_door_in_the_way_is_named_as_perceived() -> None:
     robot = NoisyRobot(SimRobot(world, labels=labelled(world)), _Renamed())  # type: ignore[arg-type]
     blocked = robot.act("grasp", "bowl A")
     assert blocked.blocking == "wardrobe B" and "wardrobe B" in blocked.feedback and "door A" not in blocked.feedback
+
+
+def test_what_opening_reveals_counts_as_perceived_though_no_frame_shows_it() -> None:
+    """The planner is told of the apple in the fridge it opened (``Observation.revealed``) while the camera
+    looks away; the perception's record of what was perceived, rTP's observed set, must say so too."""
+    import math
+
+    from more_agent.sim.labels import InstanceLabels
+
+    world = two_room_world()
+    labels = InstanceLabels()
+    labels.reserve(world.get("fridge_0"))
+    noise = perception_for("noisy:confusion=0,miss=0,fragment=0,merge=0,drift=0,room=0", world, labels, 0, TASK)
+    assert noise is not None
+    robot = NoisyRobot(SimRobot(world, labels=labels), noise)
+    assert robot.act("open", "fridge A").ok
+    x, y, yaw = robot.pose
+    world.set_robot_pose(x, y, yaw + math.pi)
+    seen = robot.sense(["fridge A"])
+    apple = world.get("apple_0").instance_id
+    assert apple in seen.revealed and apple not in seen.frame.instance
+    assert "apple_0" in noise.observed()
