@@ -4,6 +4,7 @@ import each other in a circle. Lazy imports inside functions count too."""
 from __future__ import annotations
 
 import ast
+from functools import cache
 from pathlib import Path
 
 import more_agent
@@ -50,7 +51,9 @@ def _imports(path: Path, module: str, modules: set[str]) -> set[str]:
     return found
 
 
+@cache
 def _graph() -> dict[str, set[str]]:
+    """Module -> the more_agent modules it imports; parsed once for the tests below (neither changes it)."""
     paths = {_module(p): p for p in ROOT.rglob("*.py")}
     return {m: _imports(p, m, set(paths)) for m, p in paths.items()}
 
