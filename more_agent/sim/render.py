@@ -17,7 +17,9 @@ What is drawn (docs/sensors.md):
   ``world.is_observable`` (not held, not inside a closed container). An open container, or a
   non-openable one with something inside (or on an inner shelf level), is a cage: bottom and top slabs of
   ``SLAB_FRACTION * height`` and four thin corner posts, so its contents show while its observed
-  extent stays its full box. A closed container is solid, which hides its contents.
+  extent stays its full box. A non-openable container that is not a shelf (a bag, a basket, a shopping
+  cart, a bowl, a skiff) has no top slab: nothing covers it in BEHAVIOR-1K's meshes, so its contents show
+  from above too. A closed container is solid, which hides its contents.
 No ceiling; no robot body.
 """
 
@@ -33,7 +35,7 @@ from numba import njit
 from more_agent.robot import Frame
 from more_agent.sim.camera import Camera
 from more_agent.sim.grid import Grid
-from more_agent.sim.packing import SLAB_FRACTION
+from more_agent.sim.packing import LEVELLED_CATEGORIES, SLAB_FRACTION
 from more_agent.sim.world import World, WorldObject
 
 GRID_CELL_M = 1.0
@@ -111,7 +113,8 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
             boxes.append((lo, hi, sem, 0))
         elif obj.kind == "furniture" or (obj.kind == "item" and world.is_observable(obj.name)):
             see_through = obj.is_open if obj.openable else obj.name in holds_inside
-            parts = _cage(lo, hi) if see_through else [(lo, hi)]
+            covered = obj.openable or obj.category in LEVELLED_CATEGORIES
+            parts = _cage(lo, hi, top=covered) if see_through else [(lo, hi)]
             boxes.extend((a, b, sem, obj.instance_id) for a, b in parts)
     lo = np.array([b[0] for b in boxes], dtype=np.float64).reshape(-1, 3)
     hi = np.array([b[1] for b in boxes], dtype=np.float64).reshape(-1, 3)
@@ -157,14 +160,17 @@ def _door_boxes(world: World, door: WorldObject) -> list[tuple[np.ndarray, np.nd
     return out
 
 
-def _cage(lo: np.ndarray, hi: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Bottom slab, top slab and four corner posts of an open container's box."""
+def _cage(lo: np.ndarray, hi: np.ndarray, *, top: bool = True) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Bottom slab, top slab (unless not ``top``) and four corner posts of a see-through container's box."""
     slab = SLAB_FRACTION * (hi[2] - lo[2])
     post = np.minimum(CAGE_POST_M, 0.15 * (hi[:2] - lo[:2]))
-    parts = [(lo, np.array([hi[0], hi[1], lo[2] + slab])), (np.array([lo[0], lo[1], hi[2] - slab]), hi)]
+    parts = [(lo, np.array([hi[0], hi[1], lo[2] + slab]))]
+    post_top = hi[2] - slab if top else hi[2]
+    if top:
+        parts.append((np.array([lo[0], lo[1], post_top]), hi))
     for px in (lo[0], hi[0] - post[0]):
         for py in (lo[1], hi[1] - post[1]):
-            parts.append((np.array([px, py, lo[2] + slab]), np.array([px + post[0], py + post[1], hi[2] - slab])))
+            parts.append((np.array([px, py, lo[2] + slab]), np.array([px + post[0], py + post[1], post_top])))
     return parts
 
 

@@ -147,6 +147,27 @@ def test_open_container_keeps_its_full_box():
     assert np.allclose(g.lo[mine].min(axis=0), lo) and np.allclose(g.hi[mine].max(axis=0), hi)
 
 
+def test_an_open_top_container_shows_what_it_holds_from_above_and_keeps_its_full_box():
+    """A basket (not openable, not a shelf) has no top slab, as nothing covers it in BEHAVIOR-1K's meshes: the
+    apple at its bottom shows to a camera looking straight down. An opened fridge keeps its top (the test above)."""
+    world = two_rooms()
+    world.add(WorldObject(name="basket_0", category="wicker_basket", kind="item", center=np.zeros(3),
+                          size=np.array([0.5, 0.5, 0.4])))
+    world.place_on_floor_at("basket_0", "floor_kitchen_0", (2.5, 1.5))
+    world.add(WorldObject(name="apple_1", category="apple", kind="item", center=np.zeros(3), size=np.array([0.08, 0.08, 0.08])))
+    world.place("apple_1", "basket_0", "inside")
+    g = scene_geometry(world)
+    mine = g.instance == world.get("basket_0").instance_id
+    lo, hi = world.get("basket_0").box()
+    assert mine.sum() == 5  # the bottom slab, four posts
+    assert np.allclose(g.lo[mine].min(axis=0), lo) and np.allclose(g.hi[mine].max(axis=0), hi)
+    apple = world.get("apple_1")
+    above = camera_pose(2.5, 1.5, 0.0, height_m=1.5, pitch_rad=math.pi / 2 - 1e-6)
+    frame = Renderer().render_at(world, above)
+    v, u = pixel_of(frame, apple.center)
+    assert frame.instance[v, u] == apple.instance_id
+
+
 def test_closed_door_hides_the_next_room():
     world = two_rooms()
     world.set_robot_pose(2.0, 2.0, 0.0)  # facing the door at x = 4 and the table behind it
