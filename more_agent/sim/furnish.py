@@ -30,33 +30,27 @@ _WALL_CLEAR_M = 0.01  # between a wall face and the furniture against it
 
 
 class _Obstacles:
-    """Footprints placed so far, each tagged with the wall it stands against ('' if none)."""
+    """Footprints placed so far, each tagged with the wall it stands against ('' if none). Plain floats:
+    a room holds a few dozen, and ``clear`` is asked tens of thousands of times per scene, where a loop
+    that stops at the first overlap beats numpy's per-call overhead (3x at 20 pieces)."""
 
     def __init__(self) -> None:
-        self.boxes = np.zeros((8, 4))
-        self.sides = np.zeros(8, dtype=np.int8)  # index in _SIDES + 1, 0 = free-standing
-        self.n = 0
+        self.boxes: list[tuple[float, float, float, float]] = []
+        self.sides: list[int] = []  # index in _SIDES + 1, 0 = free-standing, -2 = a door zone
 
     def add(self, rect: Rect, side: str) -> None:
-        if self.n == len(self.boxes):
-            self.boxes = np.concatenate([self.boxes, np.zeros_like(self.boxes)])
-            self.sides = np.concatenate([self.sides, np.zeros_like(self.sides)])
-        self.boxes[self.n] = rect
-        self.sides[self.n] = _SIDES.index(side) + 1 if side in _SIDES else (-2 if side == _DOOR else 0)
-        self.n += 1
+        self.boxes.append((float(rect[0]), float(rect[1]), float(rect[2]), float(rect[3])))
+        self.sides.append(_SIDES.index(side) + 1 if side in _SIDES else (-2 if side == _DOOR else 0))
 
     def clear(self, rect: Rect, side: str, walk: float) -> bool:
         """True if ``rect`` keeps ``_GAP_M`` from same-wall pieces and ``walk`` from all others."""
-        b, code = self.boxes[: self.n], (_SIDES.index(side) + 1 if side else -1)
-        codes = self.sides[: self.n]
-        gap = np.where((codes == code) | (codes == -2), _GAP_M, walk)
-        hit = (
-            (rect[0] < b[:, 2] + gap)
-            & (rect[2] > b[:, 0] - gap)
-            & (rect[1] < b[:, 3] + gap)
-            & (rect[3] > b[:, 1] - gap)
-        )
-        return not hit.any()
+        code = _SIDES.index(side) + 1 if side else -1
+        x0, y0, x1, y1 = rect
+        for (b0, b1, b2, b3), c in zip(self.boxes, self.sides):
+            gap = _GAP_M if c in (code, -2) else walk
+            if x0 < b2 + gap and x1 > b0 - gap and y0 < b3 + gap and y1 > b1 - gap:
+                return False
+        return True
 
 
 def furnish_room(
