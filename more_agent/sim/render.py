@@ -165,8 +165,9 @@ def _cage(lo: np.ndarray, hi: np.ndarray, *, top: bool = True) -> list[tuple[np.
     slab = SLAB_FRACTION * (hi[2] - lo[2])
     post = np.minimum(CAGE_POST_M, 0.15 * (hi[:2] - lo[:2]))
     parts = [(lo, np.array([hi[0], hi[1], lo[2] + slab]))]
-    post_top = hi[2] - slab if top else hi[2]
+    post_top = hi[2]
     if top:
+        post_top = hi[2] - slab
         parts.append((np.array([lo[0], lo[1], post_top]), hi))
     for px in (lo[0], hi[0] - post[0]):
         for py in (lo[1], hi[1] - post[1]):
