@@ -69,7 +69,7 @@ def reach_box(world: World, name: str) -> tuple[float, float, float, float]:
 
 def distance_to_footprint(world: World, name: str) -> float:
     """Horizontal distance from the robot base to the reach footprint of ``name`` (0 when above it)."""
-    return _point_to_box((world.robot.x, world.robot.y), reach_box(world, name))
+    return float(_gap_to_box(np.array([world.robot.x]), np.array([world.robot.y]), reach_box(world, name))[0])
 
 
 def _check_target(world: World, name: str, labels: InstanceLabels) -> WorldObject | ActionResult:
@@ -169,10 +169,7 @@ def within_reach(poses: Sequence[XY], box: tuple[float, float, float, float], gr
     """Of ``poses``, in order (k x 2), those where the base may stand on ``grid`` with ``box`` (a
     :func:`reach_box`) within ``REACH_M``: all at once, a garden's floor gives thousands."""
     xy = np.asarray(poses, dtype=float).reshape(-1, 2)
-    x, y = xy.T
-    x0, y0, x1, y1 = box
-    gap = np.hypot(np.maximum(np.maximum(x0 - x, 0.0), x - x1), np.maximum(np.maximum(y0 - y, 0.0), y - y1))
-    return xy[(gap <= REACH_M) & grid.free_at(xy)]
+    return xy[(_gap_to_box(xy[:, 0], xy[:, 1], box) <= REACH_M) & grid.free_at(xy)]
 
 
 def navigate_to(world: World, name: str, labels: InstanceLabels, config: NavConfig = DEFAULT_NAV) -> ActionResult:
@@ -210,9 +207,10 @@ def navigate_to(world: World, name: str, labels: InstanceLabels, config: NavConf
     return _fail(FailureReason.NOT_REACHABLE, f"cannot reach {labels.display(obj)}")
 
 
-def _point_to_box(p: XY, box: tuple[float, float, float, float]) -> float:
+def _gap_to_box(x: np.ndarray, y: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
+    """Horizontal distance from each point (``x``, ``y``) to the footprint ``box`` (0 inside it)."""
     x0, y0, x1, y1 = box
-    return math.hypot(max(x0 - p[0], 0.0, p[0] - x1), max(y0 - p[1], 0.0, p[1] - y1))
+    return np.hypot(np.maximum(np.maximum(x0 - x, 0.0), x - x1), np.maximum(np.maximum(y0 - y, 0.0), y - y1))
 
 
 # -- manipulation -------------------------------------------------------------------------------

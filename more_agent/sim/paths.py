@@ -150,7 +150,7 @@ def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     forbids after a non-physical step); goals must be free themselves or are ignored.
     """
     start_cell = grid.snap(*start)
-    goal_index = np.flatnonzero(grid.free_at(goals)).tolist() if len(goals) else []
+    goal_index = np.flatnonzero(grid.free_at(goals)).tolist()
     goal_cells = [grid.cell_at(*goals[i]) for i in goal_index]
     if start_cell is None or not goal_cells:
         return _NO_PATH

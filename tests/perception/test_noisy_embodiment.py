@@ -4,6 +4,7 @@ action on such a label acts on the real object; the world stays exact."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from more_agent.perception.model import NoisyPerception, perception_for
@@ -12,6 +13,7 @@ from more_agent.planners.policies import Embodiment, go_to_and
 from more_agent.scene_graph import SceneGraph
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
+from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.scene import load_scene
 from tests.sim.test_navgrid import labelled, two_room_world
 
@@ -109,10 +111,6 @@ def test_the_door_in_the_way_is_named_as_perceived() -> None:
 def test_what_opening_reveals_counts_as_perceived_though_no_frame_shows_it() -> None:
     """The planner is told of the apple in the fridge it opened (``Observation.revealed``) while the camera
     looks away; the perception's record of what was perceived, rTP's observed set, must say so too."""
-    import math
-
-    from more_agent.sim.labels import InstanceLabels
-
     world = two_room_world()
     labels = InstanceLabels()
     labels.reserve(world.get("fridge_0"))
