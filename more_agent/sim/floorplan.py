@@ -2,8 +2,8 @@
 
 Rooms get an area from their type and their furniture; indoor rooms tile the house rectangle
 (squarified treemap), gardens are bands along the house sides. Walls run along every room edge,
-doors sit on shared walls along a random spanning tree of the adjacency graph (plus a few extra),
-windows in exterior walls. Furniture goes against walls or free-standing with walkways, and each
+doors sit on shared walls along a random spanning tree of the adjacency graph (plus a few extra; a
+garden gets as many doors to the house as its inventory lists), windows in exterior walls. Furniture goes against walls or free-standing with walkways, and each
 room is checked on a raster so that a robot disc reaches every piece; a room that fails is
 refurnished, and if it still fails the scene is laid out again with that room larger. Same (name, seed) -> same plan.
 """
@@ -78,6 +78,9 @@ WINDOW_SILL_M, WINDOW_TOP_M = 0.9, 2.0
 FENCE_HEIGHT_M = 1.0
 DRIVEWAY_DEPTH_M = 4.0
 _END_MARGIN_M = 0.35  # door/window distance from a wall run's ends
+
+DOOR_CATEGORIES = frozenset({"door", "sliding_door", "garage_door"})
+"""Inventory categories of doors between rooms (elevator doors lead nowhere in a one-floor plan)."""
 
 
 @dataclass(frozen=True)
@@ -188,7 +191,8 @@ def _try_layout(
     """
     rects = _layout(rooms, items, rng, clearance_factor, growth, k)
     runs = _wall_runs(rects)
-    doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k)
+    listed = {rid: _listed_doors(objs) for rid, objs in rooms.items() if room_type(rid) in OUTDOOR_ROOM_TYPES}
+    doors = _place_doors(runs, rects, rng, closed_door_fraction, extra_door_probability, k, listed)
     if doors is None:
         return None, {r: g * 1.1 for r, g in growth.items()}
     windows = _place_windows(runs, doors, rng, k)
@@ -387,8 +391,16 @@ def _wall_runs(rects: dict[str, Rect]) -> list[_Run]:
     return runs
 
 
-def _place_doors(runs, rects, rng, closed_fraction, extra_p, k) -> list[Door] | None:
-    """Doors on a random spanning tree of the room adjacency graph (plus extras); None if disconnected."""
+def _listed_doors(objs: dict[str, int]) -> int:
+    """Door instances a room's inventory lists (bddl counts a door in the room its centre lies in)."""
+    return sum(n for key, n in objs.items() if key.rsplit("-", 1)[0] in DOOR_CATEGORIES)
+
+
+def _place_doors(runs, rects, rng, closed_fraction, extra_p, k, outdoor_doors) -> list[Door] | None:
+    """Doors on a random spanning tree of the room adjacency graph, plus extras: an indoor pair with
+    probability ``extra_p``, and for each outdoor room (``outdoor_doors``: room -> doors its inventory
+    lists) random further walls it shares with the house until it has that many doors, or a door on every
+    one. None if the rooms are not connected."""
     need = k["door_w"] + 2 * _END_MARGIN_M
     best: dict[tuple[str, str], _Run] = {}
     for run in runs:
@@ -402,11 +414,16 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k) -> list[Door] | 
         g.add_edge(*key, weight=float(rng.random()))
     if not nx.is_connected(g):
         return None
-    tree = {tuple(sorted(e)) for e in nx.minimum_spanning_edges(g, data=False)}
+    chosen = {tuple(sorted(e)) for e in nx.minimum_spanning_edges(g, data=False)}
+    for room, listed in sorted(outdoor_doors.items()):
+        spare = [key for key in sorted(best) if room in key and key not in chosen]
+        wanted = min(listed - sum(room in key for key in chosen), len(spare))
+        if wanted > 0:
+            chosen.update(spare[i] for i in rng.choice(len(spare), size=wanted, replace=False))
     doors: list[Door] = []
     for key in sorted(best):
         outdoor = any(room_type(r) in OUTDOOR_ROOM_TYPES for r in key)
-        if key not in tree and (outdoor or rng.random() >= extra_p):
+        if key not in chosen and (outdoor or rng.random() >= extra_p):
             continue
         run = best[key]
         slack = max(run.hi - run.lo - 2 * _END_MARGIN_M - k["door_w"], 0.0)

@@ -116,6 +116,29 @@ def test_outdoor_ground_doors_windows():
     assert any(p.ground == "carpet" for p in get_scene("Rs_int").ground_patches)
 
 
+def _shared_wall_m(a, b):
+    """Length of the edge two room footprints share (0 if they only touch at a corner or not at all)."""
+    if abs(a[2] - b[0]) < 1e-6 or abs(b[2] - a[0]) < 1e-6:
+        return min(a[3], b[3]) - max(a[1], b[1])
+    if abs(a[3] - b[1]) < 1e-6 or abs(b[3] - a[1]) < 1e-6:
+        return min(a[2], b[2]) - max(a[0], b[0])
+    return 0.0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_garden_has_the_doors_to_the_house_that_its_inventory_lists(seed):
+    """bddl's house_single_floor lists ten doors in its garden (front door, garage, patio, ...): the plan gives
+    the garden that many, or one on every wall it shares with a room where a door fits (the spanning tree alone
+    gave it one or two)."""
+    listed = sum(n for key, n in catalog.scene_rooms("house_single_floor")["garden_0"].items() if key.split("-")[0] in ("door", "sliding_door"))
+    s = get_scene("house_single_floor", seed)
+    garden = s.room("garden_0").bounds
+    fits = {r.id for r in s.rooms if r.id != "garden_0" and _shared_wall_m(garden, r.bounds) >= 0.9 + 2 * 0.35}
+    doors = [d for d in s.doors if "garden_0" in d.rooms]
+    assert listed == 10 and {r for d in doors for r in d.rooms} - {"garden_0"} <= fits
+    assert len(doors) == min(listed, len(fits)) >= 4
+
+
 def test_tiny_fixture_loads(tmp_path):
     s = load_scene("tests/fixtures/tiny_scene.json")
     assert [r.id for r in s.rooms] == ["kitchen_0", "living_room_0"]

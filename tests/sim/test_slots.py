@@ -76,7 +76,7 @@ def test_a_task_item_takes_the_far_end_when_the_near_corner_is_taken() -> None:
 
 
 def test_a_baking_sheet_lies_across_the_strip_a_microwave_leaves_on_a_sink() -> None:
-    inst = instantiate_in_scene(load_task("clean_a_pizza_stone"), get_scene("Beechwood_0_garden", 0), 0)
+    inst = instantiate_in_scene(load_task("clean_a_pizza_stone"), get_scene("Pomaria_1_int", 6), 6)
     world = inst.world
     sheet = world.objects[inst.scope["cookie_sheet.n.01_1"]]
     assert sheet.parent == "furniture_sink_0" and "microwave_0" in world.objects
