@@ -2,8 +2,9 @@
 
 Rooms get an area from their type and their furniture; indoor rooms tile the house rectangle
 (squarified treemap), gardens are bands along the house sides. Walls run along every room edge,
-doors sit on shared walls along a random spanning tree of the adjacency graph (plus a few extra; a
-garden gets as many doors to the house as its inventory lists), windows in exterior walls. Furniture goes against walls or free-standing with walkways, and each
+doors sit on shared walls along a random spanning tree of the indoor rooms' adjacency graph (plus a few
+extra), a garden's on as many of its walls with the house as its inventory lists doors, windows in exterior
+walls. Furniture goes against walls or free-standing with walkways, and each
 room is checked on a raster so that a robot disc reaches every piece; a room that fails is
 refurnished, and if it still fails the scene is laid out again with that room larger. Same (name, seed) -> same plan.
 """
@@ -397,10 +398,10 @@ def _listed_doors(objs: dict[str, int]) -> int:
 
 
 def _place_doors(runs, rects, rng, closed_fraction, extra_p, k, outdoor_doors) -> list[Door] | None:
-    """Doors on a random spanning tree of the room adjacency graph, plus extras: an indoor pair with
-    probability ``extra_p``, and for each outdoor room (``outdoor_doors``: room -> doors its inventory
-    lists) random further walls it shares with the house until it has that many doors, or a door on every
-    one. None if the rooms are not connected."""
+    """Doors on a random spanning tree of the indoor rooms' adjacency graph, so the house's rooms connect
+    without going outdoors; each outdoor room (``outdoor_doors``: room -> doors its inventory lists) on
+    that many random walls it shares with another room (at least one, at most one per wall); and an extra
+    door between indoor rooms with probability ``extra_p``. None if the rooms are not connected so."""
     need = k["door_w"] + 2 * _END_MARGIN_M
     best: dict[tuple[str, str], _Run] = {}
     for run in runs:
@@ -412,12 +413,13 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k, outdoor_doors) -
     g.add_nodes_from(rects)
     for key in sorted(best):
         g.add_edge(*key, weight=float(rng.random()))
-    if not nx.is_connected(g):
+    house = g.subgraph(r for r in rects if r not in outdoor_doors)
+    if not nx.is_connected(g) or (house and not nx.is_connected(house)):
         return None
-    chosen = {tuple(sorted(e)) for e in nx.minimum_spanning_edges(g, data=False)}
+    chosen = {tuple(sorted(e)) for e in nx.minimum_spanning_edges(house, data=False)}
     for room, listed in sorted(outdoor_doors.items()):
         spare = [key for key in sorted(best) if room in key and key not in chosen]
-        wanted = min(listed - sum(room in key for key in chosen), len(spare))
+        wanted = min(max(listed, 1), len(spare))
         if wanted > 0:
             chosen.update(spare[i] for i in rng.choice(len(spare), size=wanted, replace=False))
     doors: list[Door] = []
