@@ -240,16 +240,17 @@ class VoxelMap:
     def _ensure_covers(self, lo: np.ndarray, hi: np.ndarray) -> None:
         """Grow the grid (whole cells, existing content kept) so that [lo, hi] in xy lies inside: by the
         cells missing plus half the initial extent on each side that lacks them. The arrays are views into
-        buffers with room to spare, so most growths only widen the view (a copy of a house's grid is
-        tens of megabytes)."""
+        buffers with room for as much again on every side, the first one too, so most growths only widen
+        the view (a copy of a house's grid is tens of megabytes), and every view is strided alike: the
+        numba kernels that take them compile once, not again for a whole-buffer (C-contiguous) view."""
         res = self.grid.resolution_m
         if self.cls.shape[0] == 0:
             half = max(self.initial_extent_m / 2, float(np.max(hi - lo)) / 2 + res)
             centre = (lo + hi) / 2
             self._move_corner(np.round((centre - half) / res) * res)
             n = int(np.ceil(2 * half / res))
-            self._allocate((n, n))
-            self._view(np.zeros(2, dtype=int), np.array([n, n]))
+            self._allocate((3 * n, 3 * n))
+            self._view(np.array([n, n]), np.array([2 * n, 2 * n]))
             return
         size = np.array(self.shape)
         low, high = self.grid.cell_range(lo, hi)
