@@ -88,6 +88,18 @@ def test_shortest_path_goes_through_the_door_and_picks_nearest_goal():
     assert not shortest_path(grid, (2.5, 1.0), [(7.5, 2.0)]).found  # goal inside the table
 
 
+def test_a_grid_searched_again_finds_what_a_fresh_grid_finds():
+    """A grid keeps its path search between searches (``NavGrid._mcp``): each search starts afresh, so the
+    searches before it change nothing."""
+    world = two_room_world()
+    grid = nav_grid(world)
+    shortest_path(grid, (6.0, 1.0), [(2.5, 1.0)])
+    shortest_path(grid, (9.0, 3.5), [(7.5, 2.0), (2.5, 3.0)])
+    again = shortest_path(grid, (2.5, 1.0), [(9.0, 3.5), (6.0, 1.0)])
+    fresh = shortest_path(nav_grid(two_room_world()), (2.5, 1.0), [(9.0, 3.5), (6.0, 1.0)])
+    assert again.found and again == fresh
+
+
 def test_grid_cached_per_door_state():
     world = two_room_world()
     first = nav_grid(world)
