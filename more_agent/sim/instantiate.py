@@ -467,16 +467,31 @@ class _Builder:
         area: tuple[float, float, float, float] | None = None,
     ) -> None:
         obj, room = self.world.objects[name], self.world.objects[floor].room
-        half = obj.size[:2] / 2 + FLOOR_MARGIN_M
+        xy = self._floor_spot(name, room, near, area)
+        if xy is None:  # nor as it is listed: turned a quarter, as on a support (a pickup along a driveway strip)
+            obj.size = obj.size[[1, 0, 2]]
+            xy = self._floor_spot(name, room, near, area)
+        if xy is None:
+            obj.size = obj.size[[1, 0, 2]]
+            where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
+            raise InstantiationError(f"no free spot for {name} {where}")
+        self.world.place_on_floor_at(name, floor, xy)
+
+    def _floor_spot(
+        self,
+        name: str,
+        room: str | None,
+        near: WorldObject | None,
+        area: tuple[float, float, float, float] | None,
+    ) -> tuple[float, float] | None:
+        """A free spot for the item as it lies now: one that keeps every passage open, else any free one."""
+        half = self.world.objects[name].size[:2] / 2 + FLOOR_MARGIN_M
         xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area)
         if xy is None:  # every spot closes a passage: bddl still puts it on this floor, which the base drives over
             xy = free_floor_spot(
                 self.world, room, half, self.rng, near=near, exclude=name, bounds=area, keep_passages=False
             )
-        if xy is None:
-            where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
-            raise InstantiationError(f"no free spot for {name} {where}")
-        self.world.place_on_floor_at(name, floor, xy)
+        return xy
 
     # -- step 5: robot ------------------------------------------------------------------------------
     def task_objects(self) -> list[str]:

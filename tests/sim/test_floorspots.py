@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from more_agent.sim import catalog
 from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M, _passage_obstacles, free_floor_spot, keeps_passages
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.scene import load_scene
@@ -107,3 +108,17 @@ def test_an_item_whose_every_spot_closes_a_passage_still_lies_on_its_floor(task:
         if world.on_floor(o) and not keeps_passages(_passage_obstacles(world, o.name), o.center[:2], o.size[:2] / 2)
     ]
     assert closing  # the fallback was needed: some task item closes a passage where it lies
+
+
+def test_a_floor_item_that_fits_only_turned_lies_turned() -> None:
+    """A pickup listed 4.9 m along x cannot lie on a driveway strip 4 m wide along y (Beechwood_0_garden
+    seed 0); turned a quarter, as on a support, it does (the activity had stopped instantiating)."""
+    inst = instantiate_in_scene(load_task("clean_a_pickup_truck"), get_scene("Beechwood_0_garden", 0), 0)
+    world = inst.world
+    pickup = world.objects[inst.scope["pickup.n.01_1"]]
+    listed = catalog.category_size(pickup.category)
+    assert listed[0] > listed[1] and pickup.size[0] < pickup.size[1] and world.on_floor(pickup)
+    x0, y0, x1, y1 = next(p.bounds for p in world.scene.ground_patches if p.ground == "driveway")
+    assert x1 - x0 < listed[0]
+    lo, hi = pickup.box()
+    assert x0 <= lo[0] and hi[0] <= x1 and y0 <= lo[1] and hi[1] <= y1
