@@ -44,22 +44,25 @@ def free_floor_spot(
     bounds: tuple[float, float, float, float] | None = None,
     *,
     keep_passages: bool = True,
+    ground: bool = False,
 ) -> tuple[float, float] | None:
     """A random (x, y) in a room (or in ``bounds``) where a box of half extents ``half`` overlaps no
     furniture, wall, door opening or floor item; with ``near``, close beside that object's box. With
-    ``keep_passages`` (an item; not the robot), also one where the box closes no passage (``keeps_passages``)."""
+    ``keep_passages`` (an item; not the robot), also one where the box closes no passage (``keeps_passages``).
+    A ``ground`` item (a rug: its class is one the map reads as free space, and the base drives over items)
+    closes no passage and keeps no distance from door openings."""
     room = world.scene.room(room_id) if room_id else world.scene.rooms[0]
     x0, y0, x1, y1 = bounds or room.bounds
     lo, hi = np.array([x0, y0]) + half, np.array([x1, y1]) - half
     if np.any(lo >= hi):
         return None
-    boxes = _floor_obstacles(world, exclude)
+    boxes = _floor_obstacles(world, exclude, 0.0 if ground else DOOR_KEEPOUT_M)
     if near is not None:
         nlo = np.maximum(lo, near.center[:2] - near.size[:2] / 2 - 2 * half - 0.1)
         nhi = np.minimum(hi, near.center[:2] + near.size[:2] / 2 + 2 * half + 0.1)
         if np.all(nlo < nhi):
             lo, hi = nlo, nhi
-    walls = _passage_obstacles(world, exclude) if keep_passages else None
+    walls = _passage_obstacles(world, exclude) if keep_passages and not ground else None
 
     def fits(p: np.ndarray) -> bool:
         return walls is None or keeps_passages(walls, p, half)
@@ -116,8 +119,9 @@ def _clear_of(boxes: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
     return clear
 
 
-def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
-    """(n, 4) array of footprints (xmin, ymin, xmax, ymax) a floor spot must avoid."""
+def _floor_obstacles(world: World, exclude: str | None, door_keepout_m: float = DOOR_KEEPOUT_M) -> np.ndarray:
+    """(n, 4) array of footprints (xmin, ymin, xmax, ymax) a floor spot must avoid, door openings grown by
+    ``door_keepout_m``."""
     rows = [w.bounds for w in world.scene.walls]
     for obj in world.objects.values():
         if obj.name == exclude or obj.kind == "floor":
@@ -125,7 +129,7 @@ def _floor_obstacles(world: World, exclude: str | None) -> np.ndarray:
         if obj.kind == "item" and not world.on_floor(obj):
             continue
         x0, y0, x1, y1 = obj.footprint()
-        pad = DOOR_KEEPOUT_M if obj.kind == "door" else 0.0
+        pad = door_keepout_m if obj.kind == "door" else 0.0
         rows.append((x0 - pad, y0 - pad, x1 + pad, y1 + pad))
     return np.asarray(rows, dtype=float).reshape(-1, 4)
 

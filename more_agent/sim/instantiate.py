@@ -52,7 +52,7 @@ from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.matching import maximum_matching
 from more_agent.sim.packing import support_surface
 from more_agent.sim.predicates import NOT_SET_UP, PREDICATES, ROBOT_NAME
-from more_agent.sim.scene import Scene
+from more_agent.sim.scene import FREE_SPACE_CLASSES, Scene
 from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
 from more_agent.sim.tasks import (
     TaskDefinition,
@@ -485,11 +485,20 @@ class _Builder:
         area: tuple[float, float, float, float] | None,
     ) -> tuple[float, float] | None:
         """A free spot for the item as it lies now: one that keeps every passage open, else any free one."""
-        half = self.world.objects[name].size[:2] / 2 + FLOOR_MARGIN_M
-        xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area)
+        obj = self.world.objects[name]
+        half, ground = obj.size[:2] / 2 + FLOOR_MARGIN_M, obj.category in FREE_SPACE_CLASSES
+        xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area, ground=ground)
         if xy is None:  # every spot closes a passage: bddl still puts it on this floor, which the base drives over
             xy = free_floor_spot(
-                self.world, room, half, self.rng, near=near, exclude=name, bounds=area, keep_passages=False
+                self.world,
+                room,
+                half,
+                self.rng,
+                near=near,
+                exclude=name,
+                bounds=area,
+                keep_passages=False,
+                ground=ground,
             )
         return xy
 

@@ -10,7 +10,7 @@ import pytest
 from more_agent.sim import catalog
 from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M, _passage_obstacles, free_floor_spot, keeps_passages
 from more_agent.sim.instantiate import instantiate_in_scene
-from more_agent.sim.scene import load_scene
+from more_agent.sim.scene import FREE_SPACE_CLASSES, load_scene
 from more_agent.sim.scenes import get_scene
 from more_agent.sim.tasks import load_task
 from more_agent.sim.world import World, WorldObject
@@ -122,3 +122,18 @@ def test_a_floor_item_that_fits_only_turned_lies_turned() -> None:
     assert x1 - x0 < listed[0]
     lo, hi = pickup.box()
     assert x0 <= lo[0] and hi[0] <= x1 and y0 <= lo[1] and hi[1] <= y1
+
+
+def test_a_rug_is_ground_and_keeps_no_distance_from_doors() -> None:
+    """A rug's class is carpet, which the map reads as free space, and the base drives over items: it closes
+    no passage and may lie by a door, where other floor items keep ``DOOR_KEEPOUT_M`` away. In
+    Beechwood_0_garden seed 0 the living room has room for a 1 x 3 m rug only so."""
+    inst = instantiate_in_scene(load_task("unpacking_hobby_equipment"), get_scene("Beechwood_0_garden", 0), 0)
+    world = inst.world
+    rug = world.objects[inst.scope["rug.n.01_1"]]
+    assert rug.category in FREE_SPACE_CLASSES and world.on_floor(rug) and world.room_at(*rug.center[:2]) == "living_room_0"
+    listed, turned = rug.size[:2] / 2 + 0.1, rug.size[1::-1] / 2 + 0.1
+    rng = np.random.default_rng(0)
+    for half in (listed, turned):
+        assert free_floor_spot(world, "living_room_0", half, rng, exclude=rug.name, keep_passages=False) is None
+    assert free_floor_spot(world, "living_room_0", listed, rng, exclude=rug.name, ground=True) is not None
