@@ -3,10 +3,10 @@
 Rooms get an area from their type and their furniture; indoor rooms tile the house rectangle
 (squarified treemap), gardens are bands along the house sides. Walls run along every room edge,
 doors sit on shared walls along a random spanning tree of the indoor rooms' adjacency graph (plus a few
-extra), a garden's on as many of its walls with the house as its inventory lists doors, windows in exterior
-walls. Furniture goes against walls or free-standing with walkways, and each
-room is checked on a raster so that a robot disc reaches every piece; a room that fails is
-refurnished, and if it still fails the scene is laid out again with that room larger. Same (name, seed) -> same plan.
+extra), and a garden gets the doors its inventory lists on walls it shares with the house; windows sit in
+exterior walls. Furniture goes against walls or free-standing with walkways, and each room is checked
+on a raster so that a robot disc reaches every piece; a room that fails is refurnished, and if it still
+fails the scene is laid out again with that room larger. Same (name, seed) -> same plan.
 """
 
 from __future__ import annotations

@@ -119,7 +119,7 @@ def _clear_of(boxes: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
     return clear
 
 
-def _floor_obstacles(world: World, exclude: str | None, door_keepout_m: float = DOOR_KEEPOUT_M) -> np.ndarray:
+def _floor_obstacles(world: World, exclude: str | None, door_keepout_m: float) -> np.ndarray:
     """(n, 4) array of footprints (xmin, ymin, xmax, ymax) a floor spot must avoid, door openings grown by
     ``door_keepout_m``."""
     rows = [w.bounds for w in world.scene.walls]
