@@ -424,7 +424,7 @@ def _place_doors(runs, rects, rng, closed_fraction, extra_p, k, outdoor_doors) -
             chosen.update(spare[i] for i in rng.choice(len(spare), size=wanted, replace=False))
     doors: list[Door] = []
     for key in sorted(best):
-        outdoor = any(room_type(r) in OUTDOOR_ROOM_TYPES for r in key)
+        outdoor = any(r in outdoor_doors for r in key)
         if key not in chosen and (outdoor or rng.random() >= extra_p):
             continue
         run = best[key]

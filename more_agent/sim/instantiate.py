@@ -34,7 +34,9 @@ from __future__ import annotations
 
 import time
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import networkx as nx
 import numpy as np
@@ -64,6 +66,8 @@ from more_agent.sim.tasks import (
 )
 from more_agent.sim.world import World, WorldObject, floor_name
 from more_agent.vocabulary import scope_synset
+
+_T = TypeVar("_T")
 
 PLACEMENT_PREDICATES = ("ontop", "inside", "under", "nextto", "touching")
 """Init predicates that decide where an item rests, in order of preference."""
@@ -271,6 +275,19 @@ def _scope_phrase(instance: TaskInstance, scope: str) -> str:
     return f"the {category_phrase(scope_synset(scope))}"
 
 
+def _listed_or_turned(obj: WorldObject, attempt: Callable[[bool], _T | None]) -> _T | None:
+    """``attempt(turned)`` with the item as it is listed, else turned a quarter about the vertical (a box lies
+    either way: a baking sheet across a counter's free strip, a pickup along a driveway); the item is left as
+    listed when both give None."""
+    result = attempt(False)
+    if result is None:
+        obj.size = obj.size[[1, 0, 2]]
+        result = attempt(True)
+        if result is None:
+            obj.size = obj.size[[1, 0, 2]]
+    return result
+
+
 class _Builder:
     """Scratch state of one instantiation."""
 
@@ -446,14 +463,16 @@ class _Builder:
         fails this scene). An item with no slot as it comes is turned a quarter and tried again when
         its turned footprint lies within the surface (the slot grid follows the item's footprint:
         a baking sheet finds the strip a microwave leaves on a counter only lying across it)."""
-        if self.world.place_if_room(name, support, relation, stack=True, rng=self.slots):  # type: ignore[arg-type]  # ontop / inside
-            return
         obj = self.world.objects[name]
-        lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
-        obj.size = obj.size[[1, 0, 2]]
-        fits_turned = np.all(obj.size[:2] <= hi - lo)
-        if not (fits_turned and self.world.place_if_room(name, support, relation, stack=True, rng=self.slots)):  # type: ignore[arg-type]
-            obj.size = obj.size[[1, 0, 2]]
+
+        def place(turned: bool) -> bool | None:
+            if turned:
+                lo, hi, _ = support_surface(self.world.objects[support], relation)  # type: ignore[arg-type]
+                if not np.all(obj.size[:2] <= hi - lo):
+                    return None
+            return self.world.place_if_room(name, support, relation, stack=True, rng=self.slots) or None  # type: ignore[arg-type]  # ontop / inside
+
+        if _listed_or_turned(obj, place) is None:
             raise InstantiationError(f"no free spot for {name} {relation} {support}", literal_text(atom))
 
     def _default_floor(self) -> str:
@@ -467,12 +486,8 @@ class _Builder:
         area: tuple[float, float, float, float] | None = None,
     ) -> None:
         obj, room = self.world.objects[name], self.world.objects[floor].room
-        xy = self._floor_spot(name, room, near, area)
-        if xy is None:  # nor as it is listed: turned a quarter, as on a support (a pickup along a driveway strip)
-            obj.size = obj.size[[1, 0, 2]]
-            xy = self._floor_spot(name, room, near, area)
+        xy = _listed_or_turned(obj, lambda _: self._floor_spot(name, room, near, area))  # a pickup along a driveway
         if xy is None:
-            obj.size = obj.size[[1, 0, 2]]
             where = f"beside {near.name}" if near is not None else f"on the floor of {room}"
             raise InstantiationError(f"no free spot for {name} {where}")
         self.world.place_on_floor_at(name, floor, xy)

@@ -12,6 +12,7 @@ from more_agent.sim.floorplan import generate_floorplan, scene_rng
 from more_agent.sim.furnish import box_distance, reach_grid
 from more_agent.sim.scene import Scene, SceneError, load_scene
 from more_agent.sim.scenes import get_scene, scene_names
+from more_agent.vocabulary import OUTDOOR_ROOM_TYPES, room_type
 
 SAMPLE = ["Rs_int", "Rs_garden", "Beechwood_0_garden", "house_single_floor", "restaurant_diner", "office_bike",
           "grocery_store_convenience", "gates_bedroom"]
@@ -139,8 +140,7 @@ def test_a_garden_has_the_doors_to_the_house_that_its_inventory_lists(seed):
     assert len(doors) == min(listed, len(fits)) >= 4
 
 
-GARDENS = ["Beechwood_0_garden", "Merom_0_garden", "Pomaria_0_garden", "Rs_garden", "Wainscott_0_garden",
-           "house_double_floor_lower", "house_single_floor"]
+GARDENS = [name for name in scene_names() if any(room_type(r) in OUTDOOR_ROOM_TYPES for r in catalog.scene_rooms(name))]
 
 
 @pytest.mark.parametrize("name", GARDENS)
