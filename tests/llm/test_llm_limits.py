@@ -34,6 +34,11 @@ DONE = json.dumps({"reasoning": "ok", "skill": "done", "arguments": []})
 HUGE = '{"reasoning": "' + "x" * 5_000_000 + '", "skill": "done", "arguments": []}'
 
 
+def _roomy(config: LLMConfig) -> LLMConfig:
+    """``config`` with a deadline a loaded CI worker meets while moving megabytes (these tests are not about time)."""
+    return config.model_copy(update={"timeout_s": 30.0})
+
+
 def _validate(answer: object) -> object:
     return parse_plan_answer(answer, SKILLS, ["kitchen_0"], ["apple_a"])  # type: ignore[arg-type]
 
@@ -49,6 +54,7 @@ def test_oversize_answer_is_invalid_stored_truncated_and_reasked(
     fake_openai: FakeOpenAIServer, llm_config: LLMConfig
 ) -> None:
     fake_openai.push(Reply(HUGE), Reply(DONE))
+    llm_config = _roomy(llm_config)
     client = make_client("openai:m", llm_config)
     out = ask_validated(client, MESSAGES, PlanAnswer, _validate, purpose="plan")
     assert out.value.skill == "done" and len(out.completions) == 2
@@ -79,5 +85,5 @@ def test_reasoning_is_clipped() -> None:
 def test_server_error_text_is_clipped(fake_openai: FakeOpenAIServer, llm_config: LLMConfig) -> None:
     fake_openai.push(Status(404, "no such model " + "z" * 1_000_000))
     with pytest.raises(LLMBadRequest) as e:
-        make_client("openai:m", llm_config).complete(MESSAGES)
+        make_client("openai:m", _roomy(llm_config)).complete(MESSAGES)
     assert len(str(e.value)) < MAX_ERROR_CHARS + 100
