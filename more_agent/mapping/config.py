@@ -57,6 +57,12 @@ class MappingConfig(BaseModel):
     min_frontier_m: float = Field(
         0.3, ge=0, description="Frontier clusters shorter than this (cells x resolution) are dropped."
     )
+    max_frontier_m: float = Field(
+        5.0,
+        gt=0,
+        description="Frontier clusters longer than this are cut into pieces of at most this extent, one point each "
+        "(the sensor range: what one look from a point shows).",
+    )
     viewpoint_spacing_m: float = Field(
         0.25, gt=0, description="Viewpoints closer than this are stored once per object."
     )

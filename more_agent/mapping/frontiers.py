@@ -14,12 +14,14 @@ def frontier_points(
     grid: Grid,
     *,
     min_length_m: float = 0.3,
+    max_length_m: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Frontier points and cluster lengths of a BEV grid.
 
     A frontier cell is FREE with an UNKNOWN 4-neighbour (outside the grid counts as unknown);
-    8-connected frontier cells form a cluster; clusters shorter than ``min_length_m`` are dropped;
-    each cluster is represented by its cell closest to the cluster centroid.
+    8-connected frontier cells form a cluster; a cluster longer than ``max_length_m`` is cut into
+    pieces by square tiles of that side (:func:`_pieces`); clusters (pieces) shorter than
+    ``min_length_m`` are dropped; each is represented by its cell closest to its centroid.
 
     Parameters
     ----------
@@ -29,6 +31,8 @@ def frontier_points(
         Where ``occupancy`` lies.
     min_length_m : float, optional
         Shortest cluster kept, as cells x resolution.
+    max_length_m : float, optional
+        Longest cluster kept whole; None keeps every cluster whole.
 
     Returns
     -------
@@ -55,6 +59,8 @@ def frontier_points(
         return np.zeros((0, 2)), np.zeros(0)
     cells = np.argwhere(lab)
     ids = lab[cells[:, 0], cells[:, 1]] - 1
+    if max_length_m is not None:
+        ids, n = _pieces(grid.xy_of(cells), ids, max_length_m, grid.resolution_m)
     sizes = np.bincount(ids, minlength=n)
     centroid = np.stack([np.bincount(ids, weights=cells[:, a], minlength=n) for a in (0, 1)], 1) / sizes[:, None]
     d2 = ((cells - centroid[ids]) ** 2).sum(1)
@@ -62,6 +68,19 @@ def frontier_points(
     first = order[np.searchsorted(ids[order], np.arange(n))]
     keep = sizes * grid.resolution_m >= min_length_m
     return grid.xy_of(cells[first[keep]]), sizes[keep] * grid.resolution_m
+
+
+def _pieces(xy: np.ndarray, ids: np.ndarray, side_m: float, resolution_m: float) -> tuple[np.ndarray, int]:
+    """Cluster ids of the frontier cells at ``xy`` with each cluster longer than ``side_m`` cut by the squares of
+    side ``side_m`` of a lattice fixed in the world (not in the grid, whose corner moves as the map grows). One
+    point for a 30 m edge of unseen lawn sits at its middle, and once the robot has looked from there
+    (``visited_frontier_m``) the rest of the edge, still unseen, would have no point."""
+    long = np.bincount(ids)[ids] * resolution_m > side_m
+    tiles = np.floor(xy / side_m).astype(np.int64)
+    key = np.stack([ids, np.where(long, tiles[:, 0], 0), np.where(long, tiles[:, 1], 0)], axis=1)
+    _, pieces = np.unique(key, axis=0, return_inverse=True)
+    pieces = pieces.reshape(-1)
+    return pieces, int(pieces.max()) + 1
 
 
 def visible_unknown_area(

@@ -121,7 +121,7 @@ def region_graph(
         k=cfg.assignment_k,
     )
     marks.append(time.perf_counter())
-    frontier_xy, _ = frontier_points(occupancy, grid, min_length_m=cfg.min_frontier_m)
+    frontier_xy, _ = frontier_points(occupancy, grid, min_length_m=cfg.min_frontier_m, max_length_m=cfg.max_frontier_m)
     marks.append(time.perf_counter())
     return RegionGraph(
         dense=dense,

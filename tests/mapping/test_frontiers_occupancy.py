@@ -19,6 +19,23 @@ def test_frontier_points_one_per_long_cluster() -> None:
     assert 1.0 + 20 * 0.1 <= pts[0, 0] <= 1.0 + 40 * 0.1 and abs(pts[0, 1] - (2.0 + 29.5 * 0.1)) < 1e-9
 
 
+def test_a_frontier_longer_than_the_sensor_range_is_cut_into_pieces_each_with_a_point() -> None:
+    occ = np.full((142, 40), OCCUPIED, dtype=np.int8)
+    occ[1:141, 1:20] = FREE
+    occ[1:141, 20:] = UNKNOWN  # a 14 m straight edge of unseen lawn along y = 1.95 m
+    occ[5:9, 5] = UNKNOWN  # and a pocket: under 1.5 m of frontier, shorter than a piece
+    grid = Grid(resolution_m=0.1)
+    whole, whole_lengths = frontier_points(occ, grid, min_length_m=0.3)
+    pts, lengths = frontier_points(occ, grid, min_length_m=0.3, max_length_m=5.0)
+    assert len(whole) == 2 and len(pts) == 4  # the edge: one point at its middle, or one per 5 m tile
+    edge = pts[np.abs(pts[:, 1] - 1.95) < 1e-9]
+    assert sorted((edge[:, 0] // 5.0).tolist()) == [0.0, 1.0, 2.0] and all(lengths <= 5.0 + 1e-9)
+    assert abs(lengths.sum() - whole_lengths.sum()) < 1e-9  # the pieces partition the clusters
+    grown = np.pad(occ, ((7, 0), (0, 0)), constant_values=OCCUPIED)  # the map grew 0.7 m west: its corner moved
+    moved, _ = frontier_points(grown, Grid(origin_xy=(-0.7, 0.0), resolution_m=0.1), min_length_m=0.3, max_length_m=5.0)
+    assert np.allclose(np.sort(moved, axis=0), np.sort(pts, axis=0))  # the pieces lie where they lay
+
+
 def test_visible_unknown_area_is_the_unseen_floor_in_range_that_no_wall_hides() -> None:
     grid = Grid(resolution_m=0.1)
     unseen = np.full((100, 100), UNKNOWN, dtype=np.int8)
