@@ -11,6 +11,7 @@ from more_agent.eval.metrics import (
     by_system,
     by_task,
     estimate,
+    paired_sr,
     rtp,
     sr,
     summarize,
@@ -126,3 +127,15 @@ def test_summaries_per_system_and_task_count_errors() -> None:
 def test_estimates_do_not_depend_on_record_order() -> None:
     records = [rec(f"t{i}", conds=[(i % 3 == 0, ["a"]), (i % 2 == 0, ["b"])], observed=["a"]) for i in range(9)]
     assert summarize(records) == summarize(records[::-1])
+
+
+def test_paired_sr_counts_the_episodes_one_system_solves_and_the_other_does_not() -> None:
+    a = [rec(f"t{i}", success=i < 12) for i in range(20)]  # solves t0-t11
+    b = [rec(f"t{i}", success=2 <= i < 12 or i >= 18, planner="oracle") for i in range(20)]  # t2-t11, t18, t19
+    b.append(rec("only_b_ran", success=True))  # no pair: left out
+    paired = paired_sr(a, b)
+    assert (paired.n, paired.both, paired.only_a, paired.only_b, paired.neither) == (20, 10, 2, 2, 6)
+    assert paired.p_value == pytest.approx(1.0)  # two flips each way: no evidence either way
+    far = paired_sr([rec(f"t{i}", success=True) for i in range(20)], [rec(f"t{i}", success=i < 8) for i in range(20)])
+    assert far.only_a == 12 and far.p_value == pytest.approx(2 * 0.5**12)  # 12 to 0: a real difference
+    assert paired_sr(a, [rec("t0", seed=1, success=False)]).n == 0  # another seed is another episode
