@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from more_agent.eval.metrics import episode_key, estimate, paired_sr
+from more_agent.eval.metrics import estimate, paired_records, paired_sr
 from more_agent.eval.store import read_records
 from more_agent.records import EpisodeRecord
 
@@ -44,10 +44,8 @@ def main() -> None:
         f"paired over {paired.n} episodes: both {paired.both}, A only {paired.only_a}, B only {paired.only_b}, "
         f"neither {paired.neither}; McNemar p = {paired.p_value:.3g}"
     )
-    first = {episode_key(r): r for r in a}
-    for r in sorted(b, key=episode_key):
-        before = first.get(episode_key(r))
-        if before is not None and before.success != r.success:
+    for before, r in sorted(paired_records(a, b), key=lambda pair: (pair[1].task, pair[1].seed, pair[1].trial)):
+        if before.success != r.success:
             print(f"  {r.task} seed {r.seed} ({r.scene}): {outcome(before)} -> {outcome(r)}")
 
 

@@ -165,6 +165,12 @@ def episode_key(record: EpisodeRecord) -> tuple[object, ...]:
     return (record.task, record.scene, record.seed, record.trial, record.start, record.distractors, record.descriptions)
 
 
+def paired_records(a: Sequence[EpisodeRecord], b: Sequence[EpisodeRecord]) -> list[tuple[EpisodeRecord, EpisodeRecord]]:
+    """The episodes both ran (:func:`episode_key`), as (record of ``a``, record of ``b``), in ``b``'s order."""
+    first = {episode_key(r): r for r in a}
+    return [(first[k], r) for r in b if (k := episode_key(r)) in first]
+
+
 def paired_sr(a: Sequence[EpisodeRecord], b: Sequence[EpisodeRecord]) -> PairedSR:
     """Compare two systems' SR on the episodes both ran. Their SRs are not independent samples: the same worlds
     are hard for both, so the test counts only the episodes one solves and the other does not (McNemar).
@@ -172,8 +178,7 @@ def paired_sr(a: Sequence[EpisodeRecord], b: Sequence[EpisodeRecord]) -> PairedS
     cells (docs/benchmarks.md), so a few flips either way say nothing; the p-value says how many do."""
     from scipy.stats import binomtest
 
-    first = {episode_key(r): r.success for r in a}
-    pairs = [(first[k], r.success) for r in b if (k := episode_key(r)) in first]
+    pairs = [(x.success, y.success) for x, y in paired_records(a, b)]
     only_a = sum(x and not y for x, y in pairs)
     only_b = sum(y and not x for x, y in pairs)
     flips = only_a + only_b

@@ -502,8 +502,8 @@ class _Builder:
         """A free spot for the item as it lies now: one that keeps every passage open, else any free one."""
         obj = self.world.objects[name]
         half, ground = obj.size[:2] / 2 + FLOOR_MARGIN_M, obj.category in FREE_SPACE_CLASSES
-        xy = free_floor_spot(self.world, room, half, self.rng, near=near, exclude=name, bounds=area, ground=ground)
-        if xy is None:  # every spot closes a passage: bddl still puts it on this floor, which the base drives over
+        # when every spot closes a passage, bddl still puts it on this floor, which the base drives over
+        for keep in (True, False):
             xy = free_floor_spot(
                 self.world,
                 room,
@@ -512,10 +512,12 @@ class _Builder:
                 near=near,
                 exclude=name,
                 bounds=area,
-                keep_passages=False,
+                keep_passages=keep,
                 ground=ground,
             )
-        return xy
+            if xy is not None:
+                return xy
+        return None
 
     # -- step 5: robot ------------------------------------------------------------------------------
     def task_objects(self) -> list[str]:
