@@ -140,6 +140,21 @@ def test_a_garden_has_the_doors_to_the_house_that_its_inventory_lists(seed):
     assert len(doors) == min(listed, len(fits)) >= 4
 
 
+def _area(b):
+    return (b[2] - b[0]) * (b[3] - b[1])
+
+
+def test_a_garden_is_sized_by_its_own_furniture_not_by_the_house_rooms_retries():
+    """house_single_floor's layout retries 8 to 11 times over seeds 0-4 because indoor rooms' furniture does not
+    fit, and its house ends up 760-910 m². Each retry grew the garden 5 % too, to 2,010-2,326 m² (1.5-1.7 times
+    what its pool, cars, trees and chairs need); a garden's band now grows only when its own furniture does not fit."""
+    scenes = [get_scene("house_single_floor", seed) for seed in range(5)]
+    gardens = [_area(s.room("garden_0").bounds) for s in scenes]
+    houses = [sum(_area(r.bounds) for r in s.rooms if not r.outdoor) for s in scenes]
+    assert max(houses) / min(houses) > 1.15
+    assert max(gardens) / min(gardens) < 1.01 and max(gardens) < 1500
+
+
 GARDENS = [name for name in scene_names() if any(room_type(r) in OUTDOOR_ROOM_TYPES for r in catalog.scene_rooms(name))]
 
 
