@@ -45,7 +45,10 @@ class TaskGoal:
     """bddl's ground options (each a conjunction that satisfies the goal), literals over scope names."""
     categories: dict[str, frozenset[str]]
     """Scope -> object categories that count as it (the synset's own and its descendants'; for a scope the
-    goal moves, no descendant that is a scene fixture: a car is a container, but none to put in a car)."""
+    goal moves, no descendant that is a scene fixture: a car is a container, but none to put in a car), of
+    those a world can hold: one some model is of. checkout.n.03's 'checkout' and the fridge scope's
+    'electric_refrigerator' are none, so a checkout is a checkout_counter, which is furniture (a search for
+    one opened a store's microwaves, fridges and ovens while 'checkout' made it an item)."""
     named: dict[str, str]
     """Scope -> instance label the description names it by (``apple A``)."""
     floor_rooms: dict[str, str | None]
