@@ -128,6 +128,16 @@ def sized_categories() -> list[str]:
     return sorted(c for c, models in _category_models().items() if any(m in sizes for m in models))
 
 
+def has_model(category: str) -> bool:
+    """Whether a sized model is of ``category``: whether a world can hold one (not 'checkout', 'cabinet')."""
+    return category in _sized_set()
+
+
+@cache
+def _sized_set() -> frozenset[str]:
+    return frozenset(sized_categories())
+
+
 @cache
 def category_size(category: str) -> Vec3:
     """Median bounding-box extents (sx, sy, sz) in metres over a category's models.

@@ -60,7 +60,6 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
     named: dict[str, str] = {}
     floors: dict[str, str | None] = {}
     moved = {lit.args[0] for option in options for lit in option if len(lit.args) == 2 and lit.args[0] != robot}
-    held = frozenset(catalog.sized_categories())  # what a world can hold: a category some model is of
     for scope in instance.scope:
         synset = scope_synset(scope)
         if scope == robot:
@@ -73,7 +72,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         categories[scope] = frozenset(
             c
             for c in scope_categories(scope)
-            if c in held and (scope not in moved or c == own or not catalog.is_scene_fixture(c))
+            if catalog.has_model(c) and (scope not in moved or c == own or not catalog.is_scene_fixture(c))
         )
         if scope in described:
             named[scope] = instance.label(scope)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Sequence
-from functools import cache
 
 import numpy as np
 
@@ -28,7 +27,7 @@ from more_agent.planners.whereabouts import (
 )
 from more_agent.robot import XY
 from more_agent.scene_graph import ObjectNode
-from more_agent.sim.catalog import can_hold_things, category_size, is_scene_fixture, is_surface, sized_categories
+from more_agent.sim.catalog import can_hold_things, category_size, has_model, is_scene_fixture, is_surface
 from more_agent.vocabulary import RELATIONS, scope_synset
 
 OPENS_BEFORE_EXPLORING = 3
@@ -190,11 +189,10 @@ def container_likelihood(agenda: Agenda, container: str, items: Sequence[str], s
 def fits(categories: frozenset[str], container: str) -> bool:
     """Whether an object of one of ``categories`` fits in a ``container`` (sorted extents, catalog medians);
     True when a size is unknown."""
-    sized = _sized()
-    if container not in sized:
+    if not has_model(container):
         return True
     room = sorted(category_size(container))
-    item_sizes = [sorted(category_size(c)) for c in categories if c in sized]
+    item_sizes = [sorted(category_size(c)) for c in categories if has_model(c)]
     return not item_sizes or any(all(a <= b for a, b in zip(size, room)) for size in item_sizes)
 
 
@@ -469,12 +467,6 @@ def unseen_floor(sit: Situation, regions: Sequence[str]) -> dict[str, float]:
     for (rid, _), g in zip(frontiers, gain):
         best[rid] = max(best[rid], float(g))
     return best
-
-
-@cache
-def _sized() -> frozenset[str]:
-    """The categories the catalog has sizes for."""
-    return frozenset(sized_categories())
 
 
 def task_rooms(belief: Belief, agenda: Agenda) -> set[str]:
