@@ -58,9 +58,10 @@ class TaskGoal:
     moved: frozenset[str] = frozenset()
     """Scopes the goal moves (subjects of placement literals): only things that can be picked up are them."""
     stays: dict[str, str] = field(default_factory=dict)
-    """Scope -> the floor scope the description says it stays on ("every carton stays on the garage floor",
-    "leave toolbox A on the garage floor"): a goal literal ``ontop`` a floor whose room the description
-    names that holds from the start. Where the robot finds the object is that room, whatever its furniture."""
+    """Scope -> the scope the description says it stays on ("every carton stays on the garage floor",
+    "leave toolbox A on countertop A"): a goal literal ``ontop`` a floor whose room the description names,
+    or a support it names, that holds from the start. Where the robot finds an object staying on a floor is
+    that room, whatever its furniture; one staying on a support shows from close by that support."""
     activity: str = ""
     """The bddl activity the goal is of: the commonsense priors read from the activity corpus leave it out
     (:mod:`more_agent.planners.whereabouts`)."""

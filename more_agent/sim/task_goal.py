@@ -83,7 +83,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         floor_rooms=floors,
         robot=robot,
         moved=frozenset(moved),
-        stays=staying(options, floors, instance.definition.init),
+        stays=staying(options, floors, set(named), instance.definition.init),
         activity=instance.definition.name,
     )
 
@@ -100,10 +100,12 @@ def scopes_of_world_names(scope: dict[str, str], in_goal: set[str]) -> dict[str,
     return to_scope
 
 
-def staying(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | None], init: list[Any]) -> dict[str, str]:
-    """Scope -> floor scope, for each goal literal ``(ontop scope floor)`` over a floor whose room the
-    description names that the task's init already states: the description says it stays there
-    (``TaskGoal.stays``)."""
+def staying(
+    options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | None], named: set[str], init: list[Any]
+) -> dict[str, str]:
+    """Scope -> the scope it stays on, for each goal literal ``(ontop scope support)`` that the task's init
+    already states, over a floor whose room the description names or a ``named`` support: the description
+    says it stays there (``TaskGoal.stays``)."""
     initial = {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
     return {
         lit.args[0]: lit.args[1]
@@ -111,7 +113,7 @@ def staying(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | No
         for lit in option
         if lit.predicate == "ontop"
         and not lit.negated
-        and floors.get(lit.args[1]) is not None
+        and (floors.get(lit.args[1]) is not None or lit.args[1] in named)
         and ("ontop", *lit.args) in initial
     }
 

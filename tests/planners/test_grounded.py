@@ -71,7 +71,7 @@ from more_agent.planners.targets import Area
 from more_agent.planners.whereabouts import destination_share, never_inside, together_share
 from more_agent.records import EpisodeSpec, FailureReason
 from more_agent.robot import ActionResult
-from more_agent.scene_graph import ObjectNode, RegionNode
+from more_agent.scene_graph import ObjectNode, RegionNode, Relation
 from more_agent.sim.catalog import can_hold_things
 from more_agent.sim.goals import GoalChecker, GoalStatus, Literal
 from more_agent.sim.instantiate import TaskInstance, instantiate, instantiate_in_scene
@@ -418,6 +418,51 @@ def test_a_stale_task_room_is_searched_at_its_furniture_before_other_rooms() -> 
     planner.execute(step)
     later = search(belief, planner.situation(), agenda, agenda.literals[0], None).action
     assert later.target != step.target  # each piece once
+
+
+def test_the_furniture_a_task_item_was_found_on_is_looked_at_before_the_room_s_containers() -> None:
+    """A task's items are set out together, and small ones show only from close by: outfit_a_basic_toolbox seed 3
+    found the toolbox on a counter, then opened the room's dryer, washer and four cabinets for the drill that lay
+    on that counter. The furniture an item was first seen on is driven to before the containers are opened."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    yogurt, beef = "cup_of_yogurt A", "pack__of__ground_beef.n.01_1"
+    lit = next(lit for lit in agenda.literals if lit.args[0] == beef)
+    assert bind(belief, agenda.goal, beef, sit.xy) is None and not belief.found_on  # the kitchen's items are in a bag
+    assert search(belief, sit, agenda, lit, None).action.name == "go_to_and_open"
+    del belief.seen[yogurt]  # seen for the first time on countertop B, then on countertop A: found on B
+    for counter in ("countertop B", "countertop A"):
+        learn_from_graph(
+            belief,
+            sit.graph.model_copy(update={"relations": [Relation(subject=yogurt, predicate="ontop", object=counter)]}),
+        )
+    assert belief.found_on == {yogurt: "countertop B"}
+    assert bind(belief, agenda.goal, "cup__of__yogurt.n.01_1", sit.xy) == yogurt
+    step = search(belief, sit, agenda, lit, None).action
+    assert step.name == "navigate" and step.arguments[1] == "countertop B"
+    belief.looked_at.add("countertop B")  # driven to: the containers' turn
+    assert search(belief, sit, agenda, lit, None).action.name == "go_to_and_open"
+
+
+def test_the_furniture_the_description_says_a_missing_item_stays_on_is_looked_at_first() -> None:
+    """ "Leave toolbox A on countertop A" says where the toolbox is: outfit_a_basic_toolbox seed 2 opened six
+    cabinets of the utility room for it while that counter was in sight. The task goal knows what the
+    description says stays on named furniture, and only what it says (the paper's text names no counter)."""
+    belief, sit, agenda = state(planner_in(fresh_kitchen()))
+    beef, counter = "pack__of__ground_beef.n.01_1", "countertop.n.01_1"
+    lit = next(lit for lit in agenda.literals if lit.args[0] == beef)
+    goal = agenda.goal
+    told = with_goal(
+        agenda,
+        categories={**goal.categories, counter: frozenset({"countertop"})},
+        named={**goal.named, counter: "countertop B"},
+        stays={beef: counter},
+    )
+    step = search(belief, sit, told, lit, None).action
+    assert step.name == "navigate" and step.arguments[1] == "countertop B"
+    assert search(belief, sit, agenda, lit, None).action.name == "go_to_and_open"
+    for descriptions, stays in (("named", {"toolbox.n.01_1": "tabletop.n.01_1"}), ("paper", {})):
+        toolbox = instantiate("outfit_a_basic_toolbox", None, 3, descriptions=descriptions)
+        assert task_goal(toolbox, GoalChecker(toolbox)).stays == stays
 
 
 def test_the_room_of_the_tasks_objects_is_explored_before_a_fresh_one() -> None:

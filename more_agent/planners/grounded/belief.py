@@ -48,6 +48,8 @@ class Belief:
     """Label -> the region the object was first observed in."""
     relation: dict[str, Relation | None] = field(default_factory=dict)
     """Label -> where it rests as last observed or placed."""
+    found_on: dict[str, str] = field(default_factory=dict)
+    """Label -> the object it rested on when first observed, where it rested on one."""
     room_types: dict[str, str] = field(default_factory=dict)
     """Region id -> its room type, as the step's graph labels it."""
     looked_into: set[str] = field(default_factory=set)
@@ -71,11 +73,14 @@ class Belief:
 
 
 def learn_from_graph(belief: Belief, graph: SceneGraph) -> None:
-    """Remember what the step's graph shows: each object, the region it was first seen in, where it rests
-    and whether it was seen open; the rooms' types."""
+    """Remember what the step's graph shows: each object, the region it was first seen in and what it
+    rested on then, where it rests and whether it was seen open; the rooms' types."""
     belief.room_types = {rid: r.room_label for rid, r in graph.regions.items() if r.room_label}
     rel = {r.subject: (r.predicate, graph.objects[r.object].label) for r in graph.relations}
     for obj in graph.objects.values():
+        first = rel.get(obj.label) if obj.label not in belief.seen else None
+        if first is not None and first[0] == "ontop":
+            belief.found_on[obj.label] = first[1]
         belief.seen[obj.label] = obj
         belief.found_in.setdefault(obj.label, obj.region_id)
         if obj.open:

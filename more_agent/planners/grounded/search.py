@@ -88,6 +88,9 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     region_tier = room_tier(belief, region, mass) if region is not None else UNTYPED
     left = region is not None and not stale(belief, region)
     likelier = left and sit.here is not None and region_tier < here_tier
+    holder = furniture_to_look_at(belief, sit, holders(belief, sit, agenda, missing)) if searching_items else None
+    if holder is not None:
+        return object_step(sit, "navigate", holder, note)
     if (
         closed
         and closed[0].region_id == sit.here
@@ -97,7 +100,7 @@ def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: s
     ):
         return open_to_look(belief, sit, agenda, closed[0].label, held, note)
     if searching_items and (not left or region not in rooms):
-        furniture = furniture_to_look_at(belief, sit, rooms)
+        furniture = furniture_to_look_at(belief, sit, surfaces_of(sit, rooms))
         if furniture is not None:
             return object_step(sit, "navigate", furniture, note)
         in_task_rooms = [o for o in closed if o.region_id in rooms]
@@ -216,23 +219,38 @@ def is_furniture_scope(agenda: Agenda, scope: str) -> bool:
     return scope not in agenda.goal.moved and bool(cats) and all(is_furniture(c) for c in cats)
 
 
-def furniture_to_look_at(belief: Belief, sit: Situation, rooms: set[str]) -> str | None:
-    """The nearest furniture things are put on (tables, shelves, counters: ``sim.catalog.is_surface``)
-    of the task's ``rooms`` the robot has not been near (``LOOK_AT_M``): explore() clears a store's
+def furniture_to_look_at(belief: Belief, sit: Situation, furniture: Sequence[ObjectNode]) -> str | None:
+    """The nearest of ``furniture`` the robot has not been near (``LOOK_AT_M``): explore() clears a store's
     floor, but groceries on a far shelf show only from close by. None once the last drives revealed nothing."""
     if belief.fruitless_looks >= FRUITLESS_EXPLORES:
         return None
     candidates = [
         o
-        for o in sit.graph.objects.values()
-        if o.region_id in rooms
-        and o.open is None
-        and is_surface(o.category)
-        and o.label not in belief.looked_at
+        for o in furniture
+        if o.label not in belief.looked_at
         and o.label not in belief.dropped
         and _far_corner_gap(o, sit.path) > LOOK_AT_M
     ]
     return min(candidates, key=lambda o: (math.dist(o.position[:2], sit.xy), o.label)).label if candidates else None
+
+
+def surfaces_of(sit: Situation, rooms: set[str]) -> list[ObjectNode]:
+    """The furniture things are put on (tables, shelves, counters: ``sim.catalog.is_surface``) of ``rooms``."""
+    return [o for o in sit.graph.objects.values() if o.region_id in rooms and o.open is None and is_surface(o.category)]
+
+
+def holders(belief: Belief, sit: Situation, agenda: Agenda, missing: Sequence[str]) -> list[ObjectNode]:
+    """The furniture (``is_surface``) the objects the goal moves were found on, and the furniture the
+    description says a ``missing`` one stays on ("leave toolbox A on countertop A", ``TaskGoal.stays``): a
+    task's items are set out together, often on one counter or table, and small ones show only from close by.
+    Looked at before the room's containers are opened: outfit_a_basic_toolbox seed 3 found the toolbox on a
+    utility room's counter and opened the room's dryer, washer and four cabinets for the drill, which lay on
+    that counter; seed 2 opened six of them for the toolbox while the counter it stays on was in sight."""
+    goal = agenda.goal
+    found = [belief.found_on.get(belief.bound[s]) for s in _moved(agenda) if s in belief.bound]
+    told = [bind(belief, goal, goal.stays[s], sit.xy) for s in missing if s in goal.stays]
+    labels = {*found, *told}
+    return [o for o in sit.graph.objects.values() if o.label in labels and is_surface(o.category)]
 
 
 def open_to_look(belief: Belief, sit: Situation, agenda: Agenda, label: str, held: str | None, note: str) -> Choice:
@@ -485,8 +503,12 @@ def found_rooms(belief: Belief, agenda: Agenda) -> list[str]:
 
 def _found_regions(belief: Belief, agenda: Agenda) -> list[str | None]:
     """The region each object the goal moves was found in, one per bound scope."""
-    moved = dict.fromkeys(lit.args[0] for lit in agenda.literals if lit.predicate != "open")
-    return [belief.found_in[belief.bound[s]] for s in moved if s in belief.bound]
+    return [belief.found_in[belief.bound[s]] for s in _moved(agenda) if s in belief.bound]
+
+
+def _moved(agenda: Agenda) -> list[str]:
+    """The scopes the goal moves: the first argument of each relation it asks for."""
+    return list(dict.fromkeys(lit.args[0] for lit in agenda.literals if lit.predicate != "open"))
 
 
 def stale(belief: Belief, region: str) -> bool:
