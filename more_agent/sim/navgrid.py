@@ -65,6 +65,19 @@ def _mask_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[slice,
     return slice(int(lo[0]), int(hi[0])), slice(int(lo[1]), int(hi[1]))
 
 
+def _obstacle_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[slice, slice]:
+    """Slices of the cells an obstacle's ``box`` blocks: those whose centres lie inside it and, along an axis where
+    no centre does, those it overlaps. A room divider 1-4 cm thick lies between two rows of centres: it blocked
+    no cell, and the magic actions' paths (the oracle's among them) crossed it where the base's own moves, checked
+    against the footprints (``motion.move_forward``), are refused."""
+    lo, hi = grid.centre_range(box[:2], box[2:])
+    over_lo, over_hi = grid.cell_range(box[:2], box[2:])
+    thin = hi <= lo
+    lo, hi = np.where(thin, over_lo, lo), np.where(thin, over_hi, hi)
+    lo, hi = np.maximum(lo, 0), np.maximum(np.minimum(hi, shape), 0)
+    return slice(int(lo[0]), int(hi[0])), slice(int(lo[1]), int(hi[1]))
+
+
 def _door_strip(door: Door, reach: float) -> Bounds2D:
     """A door's opening extended along the wall normal by ``reach`` on either side."""
     x0, y0, x1, y1 = door.bounds()
@@ -82,7 +95,7 @@ def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
         region[_mask_box(grid, shape, room.bounds)] = True
     blocked = np.zeros(shape, dtype=bool)
     for wall in scene.walls:
-        blocked[_mask_box(grid, shape, wall.bounds)] = True
+        blocked[_obstacle_box(grid, shape, wall.bounds)] = True
     door_cells: dict[str, np.ndarray] = {}
     for door in scene.doors:
         passage = np.zeros(shape, dtype=bool)
@@ -94,7 +107,7 @@ def _build(world: World, closed: frozenset[str], config: NavConfig) -> NavGrid:
         blocked[opening] = door.id in closed
     for obj in world.objects.values():
         if obj.kind == "furniture" and obj.bottom < config.obstacle_max_bottom_m:
-            blocked[_mask_box(grid, shape, obj.footprint())] = True
+            blocked[_obstacle_box(grid, shape, obj.footprint())] = True
 
     passable = region & ~blocked
     clearance = ndimage.distance_transform_edt(passable) * res

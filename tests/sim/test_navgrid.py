@@ -63,6 +63,25 @@ def test_free_space_excludes_walls_furniture_and_keeps_clearance():
     assert not grid.is_free(20.0, 2.0)         # outside the scene
 
 
+def test_a_footprint_thinner_than_a_cell_blocks_the_grid_as_it_blocks_the_base():
+    """A room divider 2 cm thick lying between two columns of cell centres blocked no cell (putting_out_condiments
+    seed 0's dividers, 1-4 cm): the magic actions' paths crossed it where the base's own moves are refused."""
+    grid = nav_grid(two_room_world())
+    res, x_origin = grid.resolution_m, grid.origin_xy[0]
+    centre = x_origin + (math.floor((8.2 - x_origin) / res) + 0.5) * res  # a column of centres near x = 8.2 m
+    x0, x1 = centre + 0.3 * res, centre + 0.6 * res  # between that column and the next
+    scene = two_room_scene()
+    scene.furniture.append(
+        Furniture(id="room_divider_0", category="room_divider", room="living_room_0",
+                  center=((x0 + x1) / 2, 2.0, 0.9), size=(x1 - x0, 4.0, 1.8))
+    )
+    world = World.from_scene(scene)
+    world.set_robot_pose(2.5, 1.0, 0.0)
+    assert reachable(two_room_world(), (2.5, 1.0), (9.5, 2.0))
+    assert not reachable(world, (2.5, 1.0), (9.5, 2.0))  # the divider spans the living room
+    assert reachable(world, (2.5, 1.0), (6.5, 3.5))
+
+
 def test_open_door_connects_rooms_and_closed_door_blocks():
     world = two_room_world(door_open=True)
     assert reachable(world, (2.5, 1.0), (8.0, 3.5))
