@@ -60,9 +60,7 @@ def free_cells(mask: np.ndarray) -> np.ndarray:
 
 def _mask_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[slice, slice]:
     """Slices of the cells whose centres lie inside ``box``."""
-    lo, hi = grid.centre_range(box[:2], box[2:])
-    lo, hi = np.maximum(lo, 0), np.maximum(np.minimum(hi, shape), 0)
-    return slice(int(lo[0]), int(hi[0])), slice(int(lo[1]), int(hi[1]))
+    return _clipped(*grid.centre_range(box[:2], box[2:]), shape)
 
 
 def _obstacle_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[slice, slice]:
@@ -73,7 +71,11 @@ def _obstacle_box(grid: Grid, shape: tuple[int, int], box: Bounds2D) -> tuple[sl
     lo, hi = grid.centre_range(box[:2], box[2:])
     over_lo, over_hi = grid.cell_range(box[:2], box[2:])
     thin = hi <= lo
-    lo, hi = np.where(thin, over_lo, lo), np.where(thin, over_hi, hi)
+    return _clipped(np.where(thin, over_lo, lo), np.where(thin, over_hi, hi), shape)
+
+
+def _clipped(lo: np.ndarray, hi: np.ndarray, shape: tuple[int, int]) -> tuple[slice, slice]:
+    """Slices of the cells from ``lo`` to one before ``hi`` (each (ix, iy)) within a grid of ``shape``."""
     lo, hi = np.maximum(lo, 0), np.maximum(np.minimum(hi, shape), 0)
     return slice(int(lo[0]), int(hi[0])), slice(int(lo[1]), int(hi[1]))
 
