@@ -44,8 +44,13 @@ class DoneBrain:
         return self.plans.pop(0) if self.plans else plan("done")
 
 
+ANSWER_S = 10.0
+"""The requests' deadline: a scripted answer took over 0.5 s on a CI worker loaded by the others' numba compiles
+(fresh clone, 3 workers on 2 cores). The timeout test sets its own."""
+
+
 def _config(server: BrainServer, tmp_path: Path, **kw: Any) -> LLMConfig:
-    base = dict(base_url=server.base_url, api_key="sk-test", timeout_s=0.5, max_retries=0, backoff_initial_s=0.01,
+    base = dict(base_url=server.base_url, api_key="sk-test", timeout_s=ANSWER_S, max_retries=0, backoff_initial_s=0.01,
                 backoff_max_s=0.02, cache_path=tmp_path / "cache.sqlite")
     return LLMConfig(**{**base, **kw})
 
