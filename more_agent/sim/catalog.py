@@ -135,6 +135,7 @@ def has_model(category: str) -> bool:
 
 @cache
 def _sized_set() -> frozenset[str]:
+    """:func:`sized_categories` as a set, built once."""
     return frozenset(sized_categories())
 
 

@@ -62,9 +62,10 @@ driven to when an item is missing."""
 
 
 def search(belief: Belief, sit: Situation, agenda: Agenda, lit: Literal, held: str | None) -> Choice:
-    """Look for an unseen object of ``lit``: containers here, the likeliest unexplored room, other
-    containers, closed doors (before a room of a type unlikely to hold the missing items: a car is outside),
-    containers that cannot hold them (:func:`closed_containers`); give up when none is left. The containers
+    """Look for an unseen object of ``lit``: the furniture the task's items were found on or are said to stay on
+    (:func:`holders`), containers here, the likeliest unexplored room, other containers, closed doors (before a
+    room of a type unlikely to hold the missing items: a car is outside), containers that cannot hold them
+    (:func:`closed_containers`); give up when none is left. The containers
     here wait while a room of a likelier tier (:func:`room_tier`) is left to explore (cleaning_parks seed 1
     opened 18 kitchen cabinets for the bottles that lay on the lawn); those of a room of the last tier
     (``ELSEWHERE``: unlikely, and across the walls) while any room is left to explore or a door to open."""
@@ -247,9 +248,8 @@ def holders(belief: Belief, sit: Situation, agenda: Agenda, missing: Sequence[st
     utility room's counter and opened the room's dryer, washer and four cabinets for the drill, which lay on
     that counter; seed 2 opened six of them for the toolbox while the counter it stays on was in sight."""
     goal = agenda.goal
-    found = [belief.found_on.get(belief.bound[s]) for s in _moved(agenda) if s in belief.bound]
-    told = [bind(belief, goal, goal.stays[s], sit.xy) for s in missing if s in goal.stays]
-    labels = {*found, *told}
+    labels = {belief.found_on.get(belief.bound.get(s, "")) for s in _moved(agenda)}
+    labels |= {bind(belief, goal, goal.stays[s], sit.xy) for s in missing if s in goal.stays}
     return [o for o in sit.graph.objects.values() if o.label in labels and is_surface(o.category)]
 
 
