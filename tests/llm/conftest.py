@@ -22,11 +22,12 @@ def fake_openai() -> Iterator[FakeOpenAIServer]:
 
 @pytest.fixture
 def llm_config(fake_openai: FakeOpenAIServer, tmp_path: Path) -> LLMConfig:
-    """A config for the fake server: short timeout, tiny backoff, a fresh cache file."""
+    """A config for the fake server: tiny backoff, a fresh cache file, and a deadline (10 s) that a scripted answer
+    meets on a worker loaded by the others (a test of timeouts sets its own)."""
     return LLMConfig(
         base_url=fake_openai.base_url,
         api_key=TEST_API_KEY,
-        timeout_s=0.5,
+        timeout_s=10.0,
         max_retries=2,
         backoff_initial_s=0.01,
         backoff_max_s=0.05,
