@@ -21,19 +21,23 @@ from more_agent.planners.policies import (
 from more_agent.planners.policies.embodiment import PolicyConfig
 from more_agent.planners.policies.skills import (
     RETRACE_M,
+    STEP_AWAY_M,
     back_out,
     explore_frontiers,
     place_on_floor,
     plan_path,
+    step_away,
     way_back,
 )
 from more_agent.records import FailureReason
+from more_agent.robot_spec import ROBOT
 from more_agent.scene_graph import ObjectNode, OccupancyMap, SceneGraph
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import TaskInstance, instantiate_in_scene
 from more_agent.sim.labels import InstanceLabels
+from more_agent.sim.motion import clearance, obstacle_boxes
 from more_agent.sim.scene import load_scene
-from tests.sim.test_navgrid import two_room_world
+from tests.sim.test_navgrid import labelled, two_room_world
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 
@@ -263,6 +267,34 @@ def test_a_robot_blocked_in_a_slot_backs_out_through_the_exact_positions_it_came
     assert free.is_free(*body.driven[0][-1]) and body.driven[0][-1][0] < 2.0
     deep = [(2.1 + 0.07 * k, 1.03) for k in range(int(RETRACE_M / 0.07) + 5)]
     assert not back_out(DrivenBody(deep), occupancy)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("gap", "towards"),
+    [
+        ((0.197 / math.sqrt(2), 0.197 / math.sqrt(2)), (7.0, 1.0)),  # off a corner, driving at it
+        ((-0.3, 0.206), (6.0, 2.3)),  # above an edge, driving along it and a little towards it
+    ],
+)
+def test_a_blocked_robot_its_map_shows_clear_steps_straight_back_from_what_it_met(
+    gap: tuple[float, float], towards: tuple[float, float]
+) -> None:
+    """A final approach can leave the base nearer furniture than its radius, or just outside it, where the
+    agent's map shows full clearance (putting_shopping_away seed 6: 0.197 m from a stove's corner), and every
+    path drawn from there is refused at its first move. After such a refusal the robot backs straight away
+    from what it met, which the world allows and which gains clearance; with nothing met it does not move."""
+    world = two_room_world()
+    corner = np.array([8.25, 2.45])  # the table's corner; its top edge runs west from here
+    world.set_robot_pose(*(corner + gap), 0.0)
+    body = Embodiment(SimRobot(world, labels=labelled(world)))
+    boxes = obstacle_boxes(world)
+    start = body.xy
+    before = clearance(boxes, *start)
+    assert before == pytest.approx(math.hypot(*gap) if gap[0] > 0 else gap[1]) and before < ROBOT.radius_m + 0.01
+    assert not step_away(body) and body.xy == start  # nothing met
+    assert not body.follow([start, towards]) and body.xy == start  # refused at its first move
+    assert step_away(body)
+    assert math.dist(body.xy, start) == pytest.approx(STEP_AWAY_M) and clearance(boxes, *body.xy) > before
 
 
 def test_a_robot_its_map_walls_in_retraces_the_exact_way_it_drove_in() -> None:
