@@ -62,6 +62,10 @@ class TaskGoal:
     "leave toolbox A on countertop A"): a goal literal ``ontop`` a floor whose room the description names,
     or a support it names, that holds from the start. Where the robot finds an object staying on a floor is
     that room, whatever its furniture; one staying on a support shows from close by that support."""
+    leaves: dict[str, str] = field(default_factory=dict)
+    """Scope -> the floor the description says it must leave ("no sod may remain on the garden floor"): a
+    negated goal literal ``ontop`` a floor whose room the description names, that holds from the start. The
+    object lies there when the robot starts looking."""
     activity: str = ""
     """The bddl activity the goal is of: the commonsense priors read from the activity corpus leave it out
     (:mod:`more_agent.planners.whereabouts`)."""

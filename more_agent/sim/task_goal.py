@@ -84,6 +84,7 @@ def task_goal(instance: TaskInstance, goals: GoalChecker) -> TaskGoal:
         robot=robot,
         moved=frozenset(moved),
         stays=staying(options, floors, set(named), instance.definition.init),
+        leaves=leaving(options, floors, instance.definition.init),
         activity=instance.definition.name,
     )
 
@@ -106,7 +107,7 @@ def staying(
     """Scope -> the scope it stays on, for each goal literal ``(ontop scope support)`` that the task's init
     already states, over a floor whose room the description names or a ``named`` support: the description
     says it stays there (``TaskGoal.stays``)."""
-    initial = {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
+    initial = _initial(init)
     return {
         lit.args[0]: lit.args[1]
         for option in options
@@ -116,6 +117,27 @@ def staying(
         and (floors.get(lit.args[1]) is not None or lit.args[1] in named)
         and ("ontop", *lit.args) in initial
     }
+
+
+def leaving(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | None], init: list[Any]) -> dict[str, str]:
+    """Scope -> the floor it must leave, for each goal literal ``(not (ontop scope floor))`` that the task's init
+    states, over a floor whose room the description names: the description says it lies there now
+    (``TaskGoal.leaves``)."""
+    initial = _initial(init)
+    return {
+        lit.args[0]: lit.args[1]
+        for option in options
+        for lit in option
+        if lit.predicate == "ontop"
+        and lit.negated
+        and floors.get(lit.args[1]) is not None
+        and ("ontop", *lit.args) in initial
+    }
+
+
+def _initial(init: list[Any]) -> set[tuple[str, ...]]:
+    """The ground atoms of a bddl init, as tuples."""
+    return {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
 
 
 def intended_goal(parsed: list[Any]) -> list[Any]:

@@ -739,6 +739,20 @@ def test_a_room_of_a_type_likely_to_hold_the_missing_item_beats_a_big_unlikely_l
     assert room_to_explore(belief, sit, store, [beer, fridge], set()) == here  # indoors, unlikely: before the lawn
 
 
+def test_what_the_description_says_must_leave_a_floor_lies_on_it() -> None:
+    """remove_sod: "No sod may remain on the garden floor." No activity of the corpus places sods, so every room
+    was as likely, and seed 5 searched the house's rooms for 20 steps before it saw the lawn. The sods lie on
+    the lawn, as the description says (``TaskGoal.leaves``); the paper's text ("put the sods on top of the
+    wheelbarrow") names no floor and says nothing of it."""
+    sods = [f"turf.n.01_{i}" for i in range(1, 5)]
+    for descriptions, leaves in (("named", dict.fromkeys(sods, "lawn.n.01_1")), ("paper", {})):
+        inst = instantiate("remove_sod", seed=0, start="task-room", distractors=False, descriptions=descriptions)
+        goal = task_goal(inst, GoalChecker(inst))
+        assert goal.leaves == leaves and goal.stays == {}
+        mass = room_mass(agenda_of(goal), sods)
+        assert (mass == {"garden": 4.0} and mass.sides == {True}) if leaves else not mass
+
+
 def test_where_the_task_s_objects_are_known_to_be_outweighs_where_such_things_are_kept() -> None:
     """cleaning_up_branches_and_twigs on house_single_floor seed 1: one bddl activity keeps branches in a
     kitchen, so the search went through the house for 39 steps before it saw the lawn, although the

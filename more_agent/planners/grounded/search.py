@@ -363,8 +363,10 @@ def room_mass(
     list: the lawn.
 
     What is known beats what is usual. An object the description says stays on a room's floor ("leave trash can
-    A on the lawn") is in such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`),
-    or the description puts one of them there (the trash can on the lawn), the objects set out with them
+    A on the lawn"), or must leave it (``TaskGoal.leaves``, "no sod may remain on the garden floor": with no
+    activity of the corpus placing sods, remove_sod seed 5 searched the house's rooms for 20 steps first), is in
+    such a room. Once the task's items were ``found`` (room types, :func:`found_rooms`), or the description puts
+    one of them there (the trash can on the lawn), the objects set out with them
     (items, and furniture that is no scene fixture: the weeds' trash can, not a fridge or a car) are where
     those were found with the probability that two items of one bddl activity share a room type
     (:func:`~more_agent.planners.whereabouts.together_share`, 0.98), and where they are usually kept otherwise:
@@ -376,7 +378,7 @@ def room_mass(
     was found in). Where each missing object is likeliest, indoors or out, gives the mass's ``sides``
     (:func:`room_tier`)."""
     goal = agenda.goal
-    stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s, "")))}
+    stays = {s: kind for s in missing if (kind := goal.floor_rooms.get(goal.stays.get(s) or goal.leaves.get(s, "")))}
     stands = {s: furniture_rooms(goal.categories.get(s, ())) for s in missing if s not in goal.moved}
     stands = {s: rooms for s, rooms in stands.items() if rooms and s not in stays}  # a fridge: its kinds listed
     items = [s for s in missing if s not in stands and s not in stays]
