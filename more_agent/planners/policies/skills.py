@@ -94,14 +94,14 @@ STEP_AWAY_M = 0.15
 def step_away(body: Embodiment) -> bool:
     """After a blocked move that :func:`back_out` did not undo (mostly: the agent's map shows full clearance
     where the robot stands), back ``STEP_AWAY_M`` straight away from what the last blocked move met (the last
-    bump, ahead on its heading).
-    The map judges clearance by cell, and a final approach (whose exact way the map does not hold) can leave
-    the base nearer furniture than its radius where the map shows it clear; the world then allows only moves
-    that gain clearance, and every path the planner drew from there led past the corner and was blocked at its
-    first move (putting_shopping_away seed 6: all 24 remaining steps failed 0.197 m from a stove). The nearest
-    cell of the map is no guide: items on the floor, which the base drives over, show there as obstacles. The
-    blocked move brought the base nearer a box, and the distance to a box is convex along a line, so the move
-    straight back gains clearance from it. False when nothing was met or the step back is blocked too."""
+    bump, ahead on its heading). The map judges clearance by cell, and a final approach (whose exact way the map
+    does not hold) can leave the base nearer furniture than its radius where the map shows it clear; the world
+    then allows only moves that gain clearance, and every path the planner drew from there led past the corner
+    and was blocked at its first move (putting_shopping_away seed 6: all 24 remaining steps failed 0.197 m from
+    a stove). The nearest cell of the map is no guide: items on the floor, which the base drives over, show
+    there as obstacles. The blocked move brought the base nearer a box, and the distance to a box is convex
+    along a line, so the move straight back gains clearance from it. False when nothing was met or the step
+    back is blocked too."""
     if not body.bumps:
         return False
     (x, y), (bx, by) = body.xy, body.bumps[-1]
