@@ -107,15 +107,10 @@ def staying(
     """Scope -> the scope it stays on, for each goal literal ``(ontop scope support)`` that the task's init
     already states, over a floor whose room the description names or a ``named`` support: the description
     says it stays there (``TaskGoal.stays``)."""
-    initial = _initial(init)
     return {
         lit.args[0]: lit.args[1]
-        for option in options
-        for lit in option
-        if lit.predicate == "ontop"
-        and not lit.negated
-        and (floors.get(lit.args[1]) is not None or lit.args[1] in named)
-        and ("ontop", *lit.args) in initial
+        for lit in _ontop_from_the_start(options, init)
+        if not lit.negated and (floors.get(lit.args[1]) is not None or lit.args[1] in named)
     }
 
 
@@ -123,21 +118,17 @@ def leaving(options: tuple[tuple[Literal, ...], ...], floors: dict[str, str | No
     """Scope -> the floor it must leave, for each goal literal ``(not (ontop scope floor))`` that the task's init
     states, over a floor whose room the description names: the description says it lies there now
     (``TaskGoal.leaves``)."""
-    initial = _initial(init)
     return {
         lit.args[0]: lit.args[1]
-        for option in options
-        for lit in option
-        if lit.predicate == "ontop"
-        and lit.negated
-        and floors.get(lit.args[1]) is not None
-        and ("ontop", *lit.args) in initial
+        for lit in _ontop_from_the_start(options, init)
+        if lit.negated and floors.get(lit.args[1]) is not None
     }
 
 
-def _initial(init: list[Any]) -> set[tuple[str, ...]]:
-    """The ground atoms of a bddl init, as tuples."""
-    return {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
+def _ontop_from_the_start(options: tuple[tuple[Literal, ...], ...], init: list[Any]) -> list[Literal]:
+    """The goal's ``ontop`` literals, either sign, whose atom the task's init states."""
+    initial = {tuple(lit) for lit in init if isinstance(lit, list) and all(isinstance(t, str) for t in lit)}
+    return [lit for option in options for lit in option if lit.predicate == "ontop" and ("ontop", *lit.args) in initial]
 
 
 def intended_goal(parsed: list[Any]) -> list[Any]:

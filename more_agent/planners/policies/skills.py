@@ -104,10 +104,8 @@ def step_away(body: Embodiment) -> bool:
     back is blocked too."""
     if not body.bumps:
         return False
-    (x, y), (bx, by) = body.xy, body.bumps[-1]
+    (x, y), (bx, by) = body.xy, body.bumps[-1]  # the bump lies a step and the radius ahead: never on the robot
     gap = math.hypot(x - bx, y - by)
-    if gap < 1e-6:
-        return False
     return body.follow([body.xy, (x + STEP_AWAY_M * (x - bx) / gap, y + STEP_AWAY_M * (y - by) / gap)])
 
 
