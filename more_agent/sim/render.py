@@ -1,9 +1,11 @@
-"""Headless ray caster: depth, semantic, instance and flat-shaded RGB frames from a World.
+"""Headless renderer: depth, semantic, instance and flat-shaded RGB frames from a World.
 
-Everything in the world is an axis-aligned box, so a frame is cast on the CPU (numpy + numba, no
-OpenGL / X / EGL / GPU): boxes are bucketed in a uniform 2D grid of ~1 m cells, and each pixel's ray
-walks that grid (2D DDA), slab-testing the boxes of each cell and stopping at the first cell that
-holds the nearest hit. One core (no parallel loops).
+Everything in the world is an axis-aligned box, so a frame is drawn on the CPU (numpy + numba, no
+OpenGL / X / EGL / GPU) in object order, as a z-buffer rasteriser draws, with a ray caster's exact hit
+test: each box within sensor range projects to a rectangle of the image (its clipped corners' bounds),
+every pixel in that rectangle slab-tests the box with its own ray, and each pixel keeps the nearest
+entry; a tie goes to the box listed first. A pixel so sees exactly what its ray would hit first, while
+only the pixels a box can cover test it. One core (no parallel loops).
 
 What is drawn (docs/sensors.md):
 - room ground as its thin floor slab (semantic = the room's ground class, instance 0);
@@ -34,12 +36,8 @@ from numba import njit
 
 from more_agent.robot import Frame
 from more_agent.sim.camera import Camera
-from more_agent.sim.grid import Grid
 from more_agent.sim.packing import LEVELLED_CATEGORIES, SLAB_FRACTION
 from more_agent.sim.world import World, WorldObject
-
-GRID_CELL_M = 1.0
-"""Side of the acceleration grid's cells in metres."""
 
 CAGE_POST_M = 0.03
 """Side of the corner posts of an open container's cage (at most 15% of its footprint)."""
@@ -52,6 +50,12 @@ DOOR_INSET_M = 0.002
 
 PATCH_TOP_M = 0.001
 """Top of a ground patch (carpet, driveway) slab: just above the room floor so that it shows."""
+
+NEAR_M = 1e-3
+"""Depth of the plane that clips a box's corners before they are projected (those behind it would project
+through infinity). No ray can hit a box nearer than this in depth unless the box lies within
+``2 * NEAR_M`` of the camera (the image's corner rays are 1.33 times their depth long); such a box tests
+every pixel."""
 
 _STRUCTURAL_COLORS: dict[str, tuple[int, int, int]] = {
     "unlabeled": (0, 0, 0),
@@ -67,21 +71,15 @@ _STRUCTURAL_COLORS: dict[str, tuple[int, int, int]] = {
 
 @dataclass(frozen=True, eq=False)
 class SceneGeometry:
-    """The boxes a world draws (float64 corners, int32 class / instance ids) bucketed in a 2D grid.
+    """The boxes a world draws (float64 corners, int32 class / instance ids), doors first.
 
-    ``cell_start[c]:cell_start[c + 1]`` indexes ``cell_items``, the boxes overlapping cell c, with
-    c = iy * nx + ix. ``palette`` is the (n_classes, 3) float64 colour of each semantic class.
+    ``palette`` is the (n_classes, 3) float64 colour of each semantic class.
     """
 
     lo: np.ndarray
     hi: np.ndarray
     semantic: np.ndarray
     instance: np.ndarray
-    grid: Grid
-    """The bucket grid (cells of ``GRID_CELL_M``); the kernels repeat ``Grid.cell_of`` inline."""
-    shape: tuple[int, int]
-    cell_start: np.ndarray
-    cell_items: np.ndarray
     palette: np.ndarray
 
     @property
@@ -89,8 +87,8 @@ class SceneGeometry:
         return len(self.semantic)
 
 
-def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometry:
-    """Every box the world draws in its current state, with the grid that accelerates ray casting."""
+def scene_geometry(world: World) -> SceneGeometry:
+    """Every box the world draws in its current state."""
     boxes: list[tuple[np.ndarray, np.ndarray, int, int]] = []
     for door in (o for o in world.objects.values() if o.kind == "door"):
         boxes.extend(_door_boxes(world, door))
@@ -116,22 +114,11 @@ def scene_geometry(world: World, *, cell_m: float = GRID_CELL_M) -> SceneGeometr
             covered = obj.openable or obj.category in LEVELLED_CATEGORIES
             parts = _cage(lo, hi, top=covered) if see_through else [(lo, hi)]
             boxes.extend((a, b, sem, obj.instance_id) for a, b in parts)
-    lo = np.array([b[0] for b in boxes], dtype=np.float64).reshape(-1, 3)
-    hi = np.array([b[1] for b in boxes], dtype=np.float64).reshape(-1, 3)
-    x0, y0, x1, y1 = world.scene.bounds
-    x0, y0 = min(x0, lo[:, 0].min()) - cell_m, min(y0, lo[:, 1].min()) - cell_m
-    nx = int(np.ceil((max(x1, hi[:, 0].max()) + cell_m - x0) / cell_m))
-    ny = int(np.ceil((max(y1, hi[:, 1].max()) + cell_m - y0) / cell_m))
-    start, items = _build_grid(lo, hi, x0, y0, cell_m, nx, ny)
     return SceneGeometry(
-        lo=lo,
-        hi=hi,
+        lo=np.array([b[0] for b in boxes], dtype=np.float64).reshape(-1, 3),
+        hi=np.array([b[1] for b in boxes], dtype=np.float64).reshape(-1, 3),
         semantic=np.array([b[2] for b in boxes], dtype=np.int32),
         instance=np.array([b[3] for b in boxes], dtype=np.int32),
-        grid=Grid(origin_xy=(float(x0), float(y0)), resolution_m=cell_m),
-        shape=(nx, ny),
-        cell_start=start,
-        cell_items=items,
         palette=class_colors(world.class_names).astype(np.float64),
     )
 
@@ -175,35 +162,6 @@ def _cage(lo: np.ndarray, hi: np.ndarray, *, top: bool = True) -> list[tuple[np.
     return parts
 
 
-@njit(cache=True)
-def _build_grid(
-    lo: np.ndarray, hi: np.ndarray, x0: float, y0: float, cell: float, nx: int, ny: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """CSR lists of the boxes overlapping each grid cell (counting pass, then filling pass)."""
-    n = lo.shape[0]
-    ranges = np.empty((n, 4), dtype=np.int64)
-    count = np.zeros(nx * ny + 1, dtype=np.int32)
-    for b in range(n):
-        ix0 = max(0, min(nx - 1, int(np.floor((lo[b, 0] - x0) / cell))))
-        ix1 = max(0, min(nx - 1, int(np.floor((hi[b, 0] - x0) / cell))))
-        iy0 = max(0, min(ny - 1, int(np.floor((lo[b, 1] - y0) / cell))))
-        iy1 = max(0, min(ny - 1, int(np.floor((hi[b, 1] - y0) / cell))))
-        ranges[b, 0], ranges[b, 1], ranges[b, 2], ranges[b, 3] = ix0, ix1, iy0, iy1
-        for iy in range(iy0, iy1 + 1):
-            for ix in range(ix0, ix1 + 1):
-                count[iy * nx + ix + 1] += 1
-    start = np.cumsum(count).astype(np.int32)
-    fill = start[:-1].copy()
-    items = np.empty(start[-1], dtype=np.int32)
-    for b in range(n):
-        for iy in range(ranges[b, 2], ranges[b, 3] + 1):
-            for ix in range(ranges[b, 0], ranges[b, 1] + 1):
-                c = iy * nx + ix
-                items[fill[c]] = b
-                fill[c] += 1
-    return start, items
-
-
 @njit(cache=True, error_model="numpy")
 def _ray_direction(rot: np.ndarray, rays: np.ndarray, r: int) -> tuple[float, float, float]:
     """World-frame direction ``rot @ rays[r]`` (camera z = 1), no component exactly zero."""
@@ -220,102 +178,121 @@ def _ray_direction(rot: np.ndarray, rays: np.ndarray, r: int) -> tuple[float, fl
 
 
 @njit(cache=True, error_model="numpy")
-def _clip(a: float, b: float, o: float, inv: float, tn: float, tf: float) -> tuple[float, float]:
-    """The ray interval [tn, tf] narrowed to the slab a <= o + t / inv <= b along one axis."""
-    ta, tb = (a - o) * inv, (b - o) * inv
-    return max(tn, min(ta, tb)), min(tf, max(ta, tb))
+def _inverse_directions(rot: np.ndarray, rays: np.ndarray) -> np.ndarray:
+    """(n, 3) reciprocals of each pixel's world-frame ray direction: what a slab test multiplies by."""
+    inv = np.empty((rays.shape[0], 3))
+    for r in range(rays.shape[0]):
+        d = _ray_direction(rot, rays, r)
+        inv[r, 0], inv[r, 1], inv[r, 2] = 1.0 / d[0], 1.0 / d[1], 1.0 / d[2]
+    return inv
 
 
 @njit(cache=True, error_model="numpy")
-def _box_entry(
-    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, inv: tuple[float, float, float]
-) -> tuple[float, float, int]:
-    """Slab test of box ``b``: (entry t, exit t, axis of the face entered: 0 x, 1 y, 2 z)."""
-    ta, tb = (lo[b, 0] - o[0]) * inv[0], (hi[b, 0] - o[0]) * inv[0]
-    t0, t1, f = min(ta, tb), max(ta, tb), 0
-    ta, tb = (lo[b, 1] - o[1]) * inv[1], (hi[b, 1] - o[1]) * inv[1]
-    if min(ta, tb) > t0:
-        t0, f = min(ta, tb), 1
-    t1 = min(t1, max(ta, tb))
-    ta, tb = (lo[b, 2] - o[2]) * inv[2], (hi[b, 2] - o[2]) * inv[2]
-    if min(ta, tb) > t0:
-        t0, f = min(ta, tb), 2
-    t1 = min(t1, max(ta, tb))
-    return t0, t1, f
+def _squared_distance(lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray) -> float:
+    """Squared distance from point ``o`` to box ``b`` (0 inside it)."""
+    dd = 0.0
+    for a in range(3):
+        gap = max(lo[b, a] - o[a], 0.0, o[a] - hi[b, a])
+        dd += gap * gap
+    return dd
 
 
 @njit(cache=True, error_model="numpy")
-def _walk_grid(
-    r: int,
-    o: np.ndarray,
-    d: tuple[float, float, float],
-    inv: tuple[float, float, float],
-    tn: float,
-    tf: float,
-    x0: float,
-    y0: float,
-    cell: float,
-    nx: int,
-    ny: int,
-    start: np.ndarray,
-    items: np.ndarray,
+def _image_bounds(
+    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, rot: np.ndarray
+) -> tuple[float, float, float, float, bool]:
+    """Bounds (x min, x max, y min, y max) of box ``b``'s projection on the plane z = 1 of the camera at
+    ``o`` with axes ``rot``, of its part beyond the ``NEAR_M`` plane: its corners there and where its edges
+    cross that plane. False (and no bounds) when no corner lies beyond it."""
+    cam = np.empty((8, 3))
+    for k in range(8):
+        qx = (hi[b, 0] if k & 1 else lo[b, 0]) - o[0]
+        qy = (hi[b, 1] if k & 2 else lo[b, 1]) - o[1]
+        qz = (hi[b, 2] if k & 4 else lo[b, 2]) - o[2]
+        for a in range(3):
+            cam[k, a] = rot[0, a] * qx + rot[1, a] * qy + rot[2, a] * qz
+    x0, x1, y0, y1, seen = np.inf, -np.inf, np.inf, -np.inf, False
+    for k in range(8):
+        if cam[k, 2] > NEAR_M:
+            x, y, seen = cam[k, 0] / cam[k, 2], cam[k, 1] / cam[k, 2], True
+            x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+        for a in range(3):  # the edges to the corners that differ in one coordinate, each once
+            m = k ^ (1 << a)
+            if m > k and (cam[k, 2] > NEAR_M) != (cam[m, 2] > NEAR_M):
+                s = (NEAR_M - cam[k, 2]) / (cam[m, 2] - cam[k, 2])
+                x = (cam[k, 0] + s * (cam[m, 0] - cam[k, 0])) / NEAR_M
+                y = (cam[k, 1] + s * (cam[m, 1] - cam[k, 1])) / NEAR_M
+                x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+    return x0, x1, y0, y1, seen
+
+
+@njit(cache=True, error_model="numpy")
+def _pixel_rect(
+    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, rot: np.ndarray, K: np.ndarray, width: int, height: int
+) -> tuple[int, int, int, int]:
+    """Columns u0..u1 and rows v0..v1 (inclusive; empty when u0 > u1) holding every pixel whose ray can hit
+    box ``b``: its projection's bounds widened by a pixel, the whole image for a box at the camera."""
+    if _squared_distance(lo, hi, b, o) <= (2 * NEAR_M) ** 2:
+        return 0, width - 1, 0, height - 1
+    x0, x1, y0, y1, seen = _image_bounds(lo, hi, b, o, rot)
+    u0, u1 = x0 * K[0, 0] + K[0, 2] - 1.0, x1 * K[0, 0] + K[0, 2] + 1.0
+    v0, v1 = y0 * K[1, 1] + K[1, 2] - 1.0, y1 * K[1, 1] + K[1, 2] + 1.0
+    if not seen or u1 < 0 or v1 < 0 or u0 > width - 1 or v0 > height - 1:
+        return 0, -1, 0, -1
+    return max(0, int(u0)), min(width - 1, int(u1) + 1), max(0, int(v0)), min(height - 1, int(v1) + 1)
+
+
+@njit(cache=True, error_model="numpy")
+def _nearest_entries(
+    origin: np.ndarray,
+    rot: np.ndarray,
+    rays: np.ndarray,
+    K: np.ndarray,
+    width: int,
+    max_t: float,
     lo: np.ndarray,
     hi: np.ndarray,
-    mailbox: np.ndarray,
-) -> tuple[float, int, int]:
-    """Nearest box hit by ray ``r`` within [tn, tf]: (t, box, face axis), box -1 on a miss.
-
-    Walks the grid cells the ray crosses in order (Amanatides-Woo) and stops once the nearest hit
-    lies before the next cell; each box is tested once per ray (``mailbox``).
-    """
-    cx = min(nx - 1, max(0, int((o[0] + tn * d[0] - x0) / cell)))
-    cy = min(ny - 1, max(0, int((o[1] + tn * d[1] - y0) / cell)))
-    sx = 1 if d[0] > 0 else -1
-    sy = 1 if d[1] > 0 else -1
-    tmx = (x0 + (cx + (1 if sx > 0 else 0)) * cell - o[0]) * inv[0]
-    tmy = (y0 + (cy + (1 if sy > 0 else 0)) * cell - o[1]) * inv[1]
-    tdx, tdy = cell * abs(inv[0]), cell * abs(inv[1])
-    best, best_b, best_f = np.inf, -1, -1
-    while True:
-        c = cy * nx + cx
-        for k in range(start[c], start[c + 1]):
-            b = items[k]
-            if mailbox[b] == r:
-                continue
-            mailbox[b] = r
-            t0, t1, f = _box_entry(lo, hi, b, o, inv)
-            if t0 <= t1 and t0 >= 0.0 and t0 < best:
-                best, best_b, best_f = t0, b, f
-        t_exit = min(tmx, tmy)
-        if best <= t_exit or t_exit >= tf:
-            break
-        if tmx < tmy:
-            cx += sx
-            tmx += tdx
-            if cx < 0 or cx >= nx:
-                break
-        else:
-            cy += sy
-            tmy += tdy
-            if cy < 0 or cy >= ny:
-                break
-    return best, best_b, best_f
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per pixel, the depth at which its ray first enters a box, the box (-1 on a miss) and the axis of the
+    face entered (0 x, 1 y, 2 z): every box within ``max_t`` of the camera is slab-tested by the pixels of
+    its :func:`_pixel_rect`, in the boxes' order, a nearer entry replacing the one kept."""
+    n = rays.shape[0]
+    inv = _inverse_directions(rot, rays)
+    best = np.full(n, np.inf)
+    box = np.full(n, -1, dtype=np.int32)
+    face = np.zeros(n, dtype=np.int8)
+    for b in range(lo.shape[0]):
+        if _squared_distance(lo, hi, b, origin) > max_t * max_t * (1.0 + 1e-4):
+            continue  # every hit beyond the range, where the pixel shows nothing anyway
+        u0, u1, v0, v1 = _pixel_rect(lo, hi, b, origin, rot, K, width, n // width)
+        l0, l1, l2 = lo[b, 0] - origin[0], lo[b, 1] - origin[1], lo[b, 2] - origin[2]
+        h0, h1, h2 = hi[b, 0] - origin[0], hi[b, 1] - origin[1], hi[b, 2] - origin[2]
+        for v in range(v0, v1 + 1):
+            for r in range(v * width + u0, v * width + u1 + 1):
+                ta, tb = l0 * inv[r, 0], h0 * inv[r, 0]
+                t0, t1, f = min(ta, tb), max(ta, tb), 0
+                ta, tb = l1 * inv[r, 1], h1 * inv[r, 1]
+                if min(ta, tb) > t0:
+                    t0, f = min(ta, tb), 1
+                t1 = min(t1, max(ta, tb))
+                ta, tb = l2 * inv[r, 2], h2 * inv[r, 2]
+                if min(ta, tb) > t0:
+                    t0, f = min(ta, tb), 2
+                t1 = min(t1, max(ta, tb))
+                if t0 <= t1 and t0 >= 0.0 and t0 < best[r]:
+                    best[r], box[r], face[r] = t0, b, f
+    return best, box, face
 
 
 @njit(cache=True, error_model="numpy")
-def _cast(
+def _draw(
     origin: np.ndarray,
     rot: np.ndarray,
     rays: np.ndarray,
     reach: np.ndarray,
     max_t: float,
-    x0: float,
-    y0: float,
-    cell: float,
-    nx: int,
-    ny: int,
-    start: np.ndarray,
-    items: np.ndarray,
+    K: np.ndarray,
+    width: int,
     lo: np.ndarray,
     hi: np.ndarray,
     box_sem: np.ndarray,
@@ -332,27 +309,14 @@ def _cast(
     metres from the camera (the sensor range of paper S.2 is a distance, as the mapper applies it:
     :func:`ray_reach`). The colour is the class's palette entry dimmed by the face hit and by depth.
     """
-    mailbox = np.full(lo.shape[0], -1, dtype=np.int64)
-    zlo, zhi = np.inf, -np.inf
-    for b in range(lo.shape[0]):
-        zlo, zhi = min(zlo, lo[b, 2]), max(zhi, hi[b, 2])
+    best, box, face = _nearest_entries(origin, rot, rays, K, width, max_t, lo, hi)
     for r in range(rays.shape[0]):
         depth[r], sem[r], inst[r] = np.nan, 0, 0
         rgb[r, 0], rgb[r, 1], rgb[r, 2] = 0, 0, 0
-        d = _ray_direction(rot, rays, r)
-        inv = (1.0 / d[0], 1.0 / d[1], 1.0 / d[2])
-        # clip the ray to the grid's xy extent, the boxes' z extent and the range
-        tn, tf = _clip(x0, x0 + nx * cell, origin[0], inv[0], 0.0, reach[r])
-        tn, tf = _clip(y0, y0 + ny * cell, origin[1], inv[1], tn, tf)
-        tn, tf = _clip(zlo, zhi, origin[2], inv[2], tn, tf)
-        if tn > tf:
-            continue
-        best, best_b, best_f = _walk_grid(
-            r, origin, d, inv, tn, tf, x0, y0, cell, nx, ny, start, items, lo, hi, mailbox
-        )
-        if best_b >= 0 and best <= reach[r]:
-            depth[r], sem[r], inst[r] = best, box_sem[best_b], box_inst[best_b]
-            shade = (0.80 if best_f == 0 else 0.65 if best_f == 1 else 1.0) * (1.0 - 0.35 * best / max_t)
+        b = box[r]
+        if b >= 0 and best[r] <= reach[r]:
+            depth[r], sem[r], inst[r] = best[r], box_sem[b], box_inst[b]
+            shade = (0.80 if face[r] == 0 else 0.65 if face[r] == 1 else 1.0) * (1.0 - 0.35 * best[r] / max_t)
             for ch in range(3):
                 rgb[r, ch] = np.uint8(palette[sem[r], ch] * shade + 0.5)
 
@@ -379,7 +343,7 @@ def class_colors(class_names: list[str]) -> np.ndarray:
 
 
 class Renderer:
-    """Renders frames of a world through one camera; rebuilds the box grid only when ``world.layout_version`` changes."""
+    """Renders frames of a world through one camera; rebuilds the boxes only when ``world.layout_version`` changes."""
 
     def __init__(self, camera: Camera | None = None) -> None:
         self.camera = camera or Camera()
@@ -391,7 +355,7 @@ class Renderer:
         self._geometry: SceneGeometry | None = None
 
     def geometry(self, world: World) -> SceneGeometry:
-        """The world's current drawable boxes and grid (cached per world object and version)."""
+        """The world's current drawable boxes (cached per world object and version)."""
         if self._geometry is None or self._world is not world or self._version != world.layout_version:
             self._geometry = scene_geometry(world)
             self._world, self._version = world, world.layout_version
@@ -412,18 +376,14 @@ class Renderer:
         sem = np.empty(n, dtype=np.int32)
         inst = np.empty(n, dtype=np.int32)
         rgb = np.empty((n, 3), dtype=np.uint8)
-        _cast(
+        _draw(
             np.ascontiguousarray(T[:3, 3]),
             np.ascontiguousarray(T[:3, :3]),
             self._rays,
             self._reach,
             cam.max_range_m,
-            *g.grid.origin_xy,
-            g.grid.resolution_m,
-            g.shape[0],
-            g.shape[1],
-            g.cell_start,
-            g.cell_items,
+            self._K,
+            cam.width,
             g.lo,
             g.hi,
             g.semantic,

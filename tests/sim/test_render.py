@@ -1,4 +1,4 @@
-"""Ray-cast frames: depth, semantic and instance ids, occlusion by walls, doors and containers."""
+"""Rendered frames: depth, semantic and instance ids, occlusion by walls, doors and containers."""
 
 from __future__ import annotations
 
@@ -235,6 +235,49 @@ def test_the_range_is_a_distance_from_the_camera_not_a_z_depth():
     assert (frame.semantic[row, ~far] == wall).all()
     hits = np.isfinite(frame.depth)
     assert np.all(np.linalg.norm(rays[hits], axis=1) * frame.depth[hits] <= 5.0 + 1e-4)
+
+
+def nearest_entries_by_brute_force(world: World, T_world_cam: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    """Depth and instance per pixel from slab-testing every box of the world with every pixel's ray (the first
+    box listed wins a tie), cut at the sensor range: what the renderer's culling must not change."""
+    g = scene_geometry(world)
+    rays = camera.pixel_rays()
+    rot, o = T_world_cam[:3, :3], T_world_cam[:3, 3]
+    d = np.stack([rot[i, 0] * rays[:, 0] + rot[i, 1] * rays[:, 1] + rot[i, 2] for i in range(3)], axis=1)
+    d[d == 0.0] = 1e-12
+    inv = 1.0 / d
+    best, box = np.full(len(rays), np.inf), np.full(len(rays), -1)
+    for b in range(g.n_boxes):
+        ta, tb = (g.lo[b] - o) * inv, (g.hi[b] - o) * inv
+        t0, t1 = np.minimum(ta, tb).max(axis=1), np.maximum(ta, tb).min(axis=1)
+        hit = (t0 <= t1) & (t0 >= 0.0) & (t0 < best)
+        best[hit], box[hit] = t0[hit], b
+    seen = (box >= 0) & (best * np.linalg.norm(rays, axis=1) <= camera.max_range_m)
+    depth = np.where(seen, best, np.nan).reshape(camera.height, camera.width)
+    return depth, np.where(seen, g.instance[box], 0).reshape(camera.height, camera.width)
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "yaw_deg", "pitch_deg"),
+    [
+        (3.8, 2.0, 180.0, 20.0),  # back to the doorway: the door frame and the walls reach behind the camera
+        (0.25, 0.3, 45.0, 20.0),  # in a corner, both walls beside and behind
+        (1.0, 2.6, 90.0, 55.0),  # head tilted down at the fridge's front, close by
+        (5.0, 2.0, 0.0, 89.0),  # looking straight down past the table's edge
+        (2.0, 0.2, -90.0, 0.0),  # level, at the window
+    ],
+)
+def test_every_pixel_shows_the_nearest_box_its_ray_enters(x, y, yaw_deg, pitch_deg):
+    """The renderer tests a box only with the pixels of the rectangle its projection covers; boxes that reach
+    behind the camera or lie beside it must still show in every pixel whose ray enters them first."""
+    world = two_rooms()
+    world.set_open("fridge_0", True)
+    camera = Camera()
+    T = camera_pose(x, y, math.radians(yaw_deg), height_m=camera.height_m, pitch_rad=math.radians(pitch_deg))
+    frame = Renderer(camera).render_at(world, T)
+    depth, instance = nearest_entries_by_brute_force(world, T, camera)
+    assert np.array_equal(frame.instance, instance)
+    assert np.array_equal(frame.depth, depth.astype(np.float32), equal_nan=True)
 
 
 def test_rendering_is_deterministic_and_cached():
