@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
+
+INSIDE, ONTOP = 1, 2
+"""Codes of the predicates in :func:`_supports`' output (0: neither)."""
 
 
 def spatial_relations(
@@ -20,31 +24,52 @@ def spatial_relations(
     voxelised box shares the table's top voxel, from reading as inside it); the smallest such
     container wins. Otherwise A is on top of B when A's bottom is within ``tol_m`` of B's top and
     at least ``min_support_overlap`` of A's footprint lies over B's; the highest such support wins.
+    Ties go to the box listed first.
     """
-    n = len(mins)
-    if n < 2:
+    if len(mins) < 2:
         return []
-    lo = np.maximum(mins[:, None, :], mins[None, :, :])
-    hi = np.minimum(maxs[:, None, :], maxs[None, :, :])
-    overlap = np.clip(hi - lo, 0, None)  # (A, B, 3)
-    size = np.maximum(maxs - mins, 1e-9)
-    vol = size.prod(1)
-    inside = (
-        (overlap.prod(2) / vol[:, None] >= inside_fraction)
-        & (vol[:, None] < vol[None, :])
-        & (maxs[:, None, 2] < maxs[None, :, 2] - 1e-6)
+    predicate, support = _supports(
+        np.ascontiguousarray(mins, dtype=np.float64),
+        np.ascontiguousarray(maxs, dtype=np.float64),
+        tol_m,
+        inside_fraction,
+        min_support_overlap,
     )
-    footprint = overlap[..., 0] * overlap[..., 1] / (size[:, 0] * size[:, 1])[:, None]
-    touching = np.abs(mins[:, None, 2] - maxs[None, :, 2]) <= tol_m
-    ontop = (footprint >= min_support_overlap) & touching & (vol[:, None] < vol[None, :])
-    np.fill_diagonal(inside, False)
-    np.fill_diagonal(ontop, False)
-    out: list[tuple[int, str, int]] = []
+    names = {INSIDE: "inside", ONTOP: "ontop"}
+    return [(a, names[int(p)], int(support[a])) for a, p in enumerate(predicate.tolist()) if p]
+
+
+@njit(cache=True)
+def _supports(
+    mins: np.ndarray, maxs: np.ndarray, tol_m: float, inside_fraction: float, min_support_overlap: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per box A, its predicate code (``INSIDE``, ``ONTOP`` or 0) and the box it relates to, by the rules of
+    :func:`spatial_relations`: one pass over the pairs, each box's best container and best support so far
+    kept (a strictly better one replaces it, so ties go to the box listed first)."""
+    n = mins.shape[0]
+    size = np.maximum(maxs - mins, 1e-9)
+    vol = size[:, 0] * size[:, 1] * size[:, 2]
+    predicate = np.zeros(n, dtype=np.int8)
+    support = np.full(n, -1, dtype=np.int64)
     for a in range(n):
-        if inside[a].any():  # the smallest container holds it
-            cands = np.flatnonzero(inside[a])
-            out.append((a, "inside", int(cands[np.argmin(vol[cands])])))
-        elif ontop[a].any():
-            cands = np.flatnonzero(ontop[a])
-            out.append((a, "ontop", int(cands[np.argmax(maxs[cands, 2])])))
-    return out
+        container, best_vol, base, best_top = -1, np.inf, -1, -np.inf
+        for b in range(n):
+            if b == a or not vol[a] < vol[b]:
+                continue
+            ox = max(min(maxs[a, 0], maxs[b, 0]) - max(mins[a, 0], mins[b, 0]), 0.0)
+            oy = max(min(maxs[a, 1], maxs[b, 1]) - max(mins[a, 1], mins[b, 1]), 0.0)
+            oz = max(min(maxs[a, 2], maxs[b, 2]) - max(mins[a, 2], mins[b, 2]), 0.0)
+            if ox * oy * oz / vol[a] >= inside_fraction and maxs[a, 2] < maxs[b, 2] - 1e-6:
+                if vol[b] < best_vol:
+                    container, best_vol = b, vol[b]
+            elif (
+                ox * oy / (size[a, 0] * size[a, 1]) >= min_support_overlap
+                and abs(mins[a, 2] - maxs[b, 2]) <= tol_m
+                and maxs[b, 2] > best_top
+            ):
+                base, best_top = b, maxs[b, 2]
+        if container >= 0:
+            predicate[a], support[a] = INSIDE, container
+        elif base >= 0:
+            predicate[a], support[a] = ONTOP, base
+    return predicate, support
