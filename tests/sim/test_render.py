@@ -258,22 +258,28 @@ def nearest_entries_by_brute_force(world: World, T_world_cam: np.ndarray, camera
 
 
 @pytest.mark.parametrize(
-    ("x", "y", "yaw_deg", "pitch_deg"),
+    ("x", "y", "z", "yaw_deg", "pitch_deg"),
     [
-        (3.8, 2.0, 180.0, 20.0),  # back to the doorway: the door frame and the walls reach behind the camera
-        (0.25, 0.3, 45.0, 20.0),  # in a corner, both walls beside and behind
-        (1.0, 2.6, 90.0, 55.0),  # head tilted down at the fridge's front, close by
-        (5.0, 2.0, 0.0, 89.0),  # looking straight down past the table's edge
-        (2.0, 0.2, -90.0, 0.0),  # level, at the window
-    ],
+        (3.8, 2.0, 1.2, 180.0, 20.0),  # back to the doorway: the door frame and the walls reach behind the camera
+        (0.25, 0.3, 1.2, 45.0, 20.0),  # in a corner, both walls beside and behind
+        (1.0, 2.6, 1.2, 90.0, 55.0),  # head tilted down at the fridge's front, close by
+        (5.0, 2.0, 1.2, 0.0, 89.0),  # looking straight down past the table's edge
+        (2.0, 0.2, 1.2, -90.0, 0.0),  # level, at the window
+        (6.0, 2.0, 0.5, 180.0, 10.0),  # inside the table's box: it is not seen, the rest is
+        (7.9485, 2.0, 1.2, 0.0, 0.0),  # 1.5 mm from the east wall's face
+        (2.5, 1.5, 1.2, 0.0, 90.0 - 1e-4),  # straight down at a sheet 0.3 mm below the lens: no corner beyond
+    ],  # the near plane, yet every ray hits it
 )
-def test_every_pixel_shows_the_nearest_box_its_ray_enters(x, y, yaw_deg, pitch_deg):
+def test_every_pixel_shows_the_nearest_box_its_ray_enters(x, y, z, yaw_deg, pitch_deg):
     """The renderer tests a box only with the pixels of the rectangle its projection covers; boxes that reach
-    behind the camera or lie beside it must still show in every pixel whose ray enters them first."""
+    behind the camera, lie beside it, hold it or touch it must still show in every pixel whose ray enters them
+    first."""
     world = two_rooms()
     world.set_open("fridge_0", True)
+    sheet = np.array([0.4, 0.4, 0.0005])
+    world.add(WorldObject(name="sheet_0", category="table", kind="furniture", center=np.array([2.5, 1.5, 1.2 - 0.0003 - sheet[2] / 2]), size=sheet))
     camera = Camera()
-    T = camera_pose(x, y, math.radians(yaw_deg), height_m=camera.height_m, pitch_rad=math.radians(pitch_deg))
+    T = camera_pose(x, y, math.radians(yaw_deg), height_m=z, pitch_rad=math.radians(pitch_deg))
     frame = Renderer(camera).render_at(world, T)
     depth, instance = nearest_entries_by_brute_force(world, T, camera)
     assert np.array_equal(frame.instance, instance)
