@@ -8,6 +8,8 @@ from numba import njit
 INSIDE, ONTOP = 1, 2
 """Codes of the predicates in :func:`_supports`' output (0: neither)."""
 
+_PREDICATES = {INSIDE: "inside", ONTOP: "ontop"}
+
 
 def spatial_relations(
     mins: np.ndarray,
@@ -35,8 +37,7 @@ def spatial_relations(
         inside_fraction,
         min_support_overlap,
     )
-    names = {INSIDE: "inside", ONTOP: "ontop"}
-    return [(a, names[int(p)], int(support[a])) for a, p in enumerate(predicate.tolist()) if p]
+    return [(a, _PREDICATES[p], int(support[a])) for a, p in enumerate(predicate.tolist()) if p]
 
 
 @njit(cache=True)

@@ -199,12 +199,12 @@ def _squared_distance(lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray) -> 
 
 @njit(cache=True, error_model="numpy")
 def _image_bounds(
-    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, rot: np.ndarray
+    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, rot: np.ndarray, cam: np.ndarray
 ) -> tuple[float, float, float, float, bool]:
     """Bounds (x min, x max, y min, y max) of box ``b``'s projection on the plane z = 1 of the camera at
     ``o`` with axes ``rot``, of its part beyond the ``NEAR_M`` plane: its corners there and where its edges
-    cross that plane. False (and no bounds) when no corner lies beyond it."""
-    cam = np.empty((8, 3))
+    cross that plane. False (and no bounds) when no corner lies beyond it. ``cam`` (8 x 3) is scratch space
+    for the corners in the camera frame (one array for every box of a frame)."""
     for k in range(8):
         qx = (hi[b, 0] if k & 1 else lo[b, 0]) - o[0]
         qy = (hi[b, 1] if k & 2 else lo[b, 1]) - o[1]
@@ -228,13 +228,26 @@ def _image_bounds(
 
 @njit(cache=True, error_model="numpy")
 def _pixel_rect(
-    lo: np.ndarray, hi: np.ndarray, b: int, o: np.ndarray, rot: np.ndarray, K: np.ndarray, width: int, height: int
+    lo: np.ndarray,
+    hi: np.ndarray,
+    b: int,
+    o: np.ndarray,
+    rot: np.ndarray,
+    K: np.ndarray,
+    width: int,
+    height: int,
+    max_t: float,
+    cam: np.ndarray,
 ) -> tuple[int, int, int, int]:
     """Columns u0..u1 and rows v0..v1 (inclusive; empty when u0 > u1) holding every pixel whose ray can hit
-    box ``b``: its projection's bounds widened by a pixel, the whole image for a box at the camera."""
-    if _squared_distance(lo, hi, b, o) <= (2 * NEAR_M) ** 2:
+    box ``b`` within ``max_t`` of the camera: none for a box beyond that range (where a pixel shows nothing
+    anyway), the whole image for a box at the camera, else its projection's bounds widened by a pixel."""
+    dd = _squared_distance(lo, hi, b, o)
+    if dd > max_t * max_t * (1.0 + 1e-4):
+        return 0, -1, 0, -1
+    if dd <= (2 * NEAR_M) ** 2:
         return 0, width - 1, 0, height - 1
-    x0, x1, y0, y1, seen = _image_bounds(lo, hi, b, o, rot)
+    x0, x1, y0, y1, seen = _image_bounds(lo, hi, b, o, rot, cam)
     u0, u1 = x0 * K[0, 0] + K[0, 2] - 1.0, x1 * K[0, 0] + K[0, 2] + 1.0
     v0, v1 = y0 * K[1, 1] + K[1, 2] - 1.0, y1 * K[1, 1] + K[1, 2] + 1.0
     if not seen or u1 < 0 or v1 < 0 or u0 > width - 1 or v0 > height - 1:
@@ -254,17 +267,16 @@ def _nearest_entries(
     hi: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per pixel, the depth at which its ray first enters a box, the box (-1 on a miss) and the axis of the
-    face entered (0 x, 1 y, 2 z): every box within ``max_t`` of the camera is slab-tested by the pixels of
-    its :func:`_pixel_rect`, in the boxes' order, a nearer entry replacing the one kept."""
+    face entered (0 x, 1 y, 2 z): every box is slab-tested by the pixels of its :func:`_pixel_rect` (none
+    beyond ``max_t``), in the boxes' order, a nearer entry replacing the one kept."""
     n = rays.shape[0]
     inv = _inverse_directions(rot, rays)
     best = np.full(n, np.inf)
     box = np.full(n, -1, dtype=np.int32)
     face = np.zeros(n, dtype=np.int8)
+    cam = np.empty((8, 3))
     for b in range(lo.shape[0]):
-        if _squared_distance(lo, hi, b, origin) > max_t * max_t * (1.0 + 1e-4):
-            continue  # every hit beyond the range, where the pixel shows nothing anyway
-        u0, u1, v0, v1 = _pixel_rect(lo, hi, b, origin, rot, K, width, n // width)
+        u0, u1, v0, v1 = _pixel_rect(lo, hi, b, origin, rot, K, width, n // width, max_t, cam)
         l0, l1, l2 = lo[b, 0] - origin[0], lo[b, 1] - origin[1], lo[b, 2] - origin[2]
         h0, h1, h2 = hi[b, 0] - origin[0], hi[b, 1] - origin[1], hi[b, 2] - origin[2]
         for v in range(v0, v1 + 1):
