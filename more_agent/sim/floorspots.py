@@ -69,17 +69,25 @@ def free_floor_spot(
 
     for _ in range(SAMPLE_TRIES):
         p = rng.uniform(lo, hi)
-        if not np.any(np.all((boxes[:, :2] < p + half) & (boxes[:, 2:] > p - half), axis=1)) and fits(p):
+        if not _overlaps(boxes, p - half, p + half).any() and fits(p):
             return float(p[0]), float(p[1])
     # Crowded room: scan a raster of candidate centres and draw among the free ones.
     gx, gy = np.meshgrid(np.arange(lo[0], hi[0], RASTER_STEP_M), np.arange(lo[1], hi[1], RASTER_STEP_M))
     pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
+    item_lo, item_hi = (pts - half).T, (pts + half).T
     blocked = np.zeros(len(pts), dtype=bool)
     for box in boxes:
-        blocked |= np.all((box[:2] < pts + half) & (box[2:] > pts - half), axis=1)
+        blocked |= _overlaps(box, item_lo, item_hi)
     free = pts[~blocked]
     p = next((free[i] for i in rng.permutation(len(free)) if fits(free[i])), None)
     return None if p is None else (float(p[0]), float(p[1]))
+
+
+def _overlaps(boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Whether footprints (``boxes``: (..., 4) xmin, ymin, xmax, ymax) overlap the box from ``lo`` to ``hi`` (x, y
+    first; either side may hold many). One comparison per side: ``np.all`` over an axis of 2 cost the crowded
+    rooms' draws more than the comparisons themselves."""
+    return (boxes[..., 0] < hi[0]) & (boxes[..., 1] < hi[1]) & (boxes[..., 2] > lo[0]) & (boxes[..., 3] > lo[1])
 
 
 def keeps_passages(obstacles: np.ndarray, p: np.ndarray, half: np.ndarray) -> bool:
