@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from more_agent.sim import catalog
+from more_agent.sim import catalog, packing
 from more_agent.sim.goals import GoalChecker
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.placement_audit import enclosing_object
@@ -127,3 +127,59 @@ def test_an_item_rests_at_a_free_slot_the_seed_draws_not_the_first_in_reading_or
     assert {n: tuple(o.center) for n, o in first.world.objects.items()} == {
         n: tuple(o.center) for n, o in second.world.objects.items()
     }  # the same seed, the same world
+
+
+def _meets(box: WorldObject, bottom: np.ndarray, top: np.ndarray) -> bool:
+    """Whether ``box`` overlaps the space from ``bottom`` to ``top`` by more than 1e-5 m along every axis."""
+    return all(
+        box.center[k] - box.size[k] / 2 < top[k] - 1e-5 and box.center[k] + box.size[k] / 2 > bottom[k] + 1e-5
+        for k in range(3)
+    )
+
+
+def _flush_box(name: str, slot: np.ndarray, half: np.ndarray, z: float) -> WorldObject:
+    """A 10 cm box beside an item at ``slot`` (half extents ``half``) whose x-distance from the slot equals half the
+    item plus half the box exactly in floating point: flush against it, taking no slot."""
+    x = slot[0] + half[0] + 0.05
+    gap = abs(slot[0] - x)
+    h = gap - half[0]
+    while half[0] + h != gap:  # the box's half width that adds up to the gap exactly
+        h = float(np.nextafter(h, np.inf if half[0] + h < gap else -np.inf))
+    return WorldObject(name=name, category="box", kind="item", center=np.array([x, slot[1], z + 0.05]),
+                       size=np.array([2 * h, 0.1, 0.1]))
+
+
+def test_the_first_free_slot_is_the_first_no_box_in_the_items_space_covers() -> None:
+    """``in_space`` and ``free_slot`` against their definitions written out box by box: a box is in the space of
+    an item on a surface when it overlaps it by more than 1e-5 m along all three axes (touching boxes, and boxes
+    above the item's height, are not); a slot is taken when such a box lies closer than half the item (with the
+    slot gap) plus half the box along both x and y. Boxes on a 5 cm lattice make touching faces common."""
+    rng = np.random.default_rng(0)
+    table = WorldObject(name="table_0", category="table", kind="furniture",
+                        center=np.array([1.0, 1.0, 0.375]), size=np.array([1.2, 0.8, 0.75]))
+    lo, hi, z = packing.support_surface(table, "ontop")
+    lattice = 0.05
+    for _ in range(40):
+        others = [
+            WorldObject(name=f"box_{i}", category="box", kind="item",
+                        center=np.round(rng.uniform([0.3, 0.5, 0.7], [1.7, 1.5, 1.1]) / lattice) * lattice,
+                        size=np.round(rng.uniform(0.05, 0.3, 3) / lattice) * lattice)
+            for i in range(int(rng.integers(0, 12)))
+        ]
+        item = WorldObject(name="item_0", category="apple", kind="item", center=np.zeros(3),
+                           size=np.round(rng.uniform(0.05, 0.25, 3) / lattice) * lattice)
+        height = float(item.size[2])
+        half = item.size[:2] / 2 + packing.SLOT_GAP_M / 2
+        slots = packing._slots(lo, hi, half, flush=False)
+        others += [_flush_box(f"flush_{k}", s, half, z) for k, s in enumerate(slots[rng.integers(0, len(slots), 2)])]
+        there = [o for o in others if _meets(o, np.array([lo[0], lo[1], z]), np.array([hi[0], hi[1], z + height]))]
+        assert [o.name for o in packing.in_space(others, lo, hi, z, height)] == [o.name for o in there]
+        free = [
+            s for s in slots
+            if not any(all(abs(s[k] - o.center[k]) < half[k] + o.size[k] / 2 for k in (0, 1)) for o in there)
+        ]
+        slot = packing.free_slot(item, table, "ontop", others)
+        if free:
+            assert slot is not None and np.array_equal(slot[:2], free[0]) and slot[2] == z + height / 2
+        else:
+            assert slot is None
