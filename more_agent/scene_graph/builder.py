@@ -206,8 +206,7 @@ class SceneGraphBuilder:
         blocked = np.isin(self.voxels.top_class, self._structure_ids)
         voxels = self.voxels.instance_voxels()
         boxes = dict(self._boxes)  # what the builder keeps, under what this map shows: the build keeps no box
-        for iid, pts in voxels.items():
-            boxes[iid] = self._voxel_box(pts)
+        boxes.update(self._voxel_boxes(voxels))
         for iid, box in self._glimpsed.items():
             if iid not in voxels and iid not in self._remembered:
                 boxes[iid] = box
@@ -268,6 +267,17 @@ class SceneGraphBuilder:
         """The box (min, max corners) around voxels (n x 3 centres)."""
         half = self.config.resolution_m / 2
         return voxel_centres.min(0) - half, voxel_centres.max(0) + half
+
+    def _voxel_boxes(self, voxels: Mapping[int, np.ndarray]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """``_voxel_box`` of every instance at once: one reduction over all the voxels, not two numpy calls per
+        object (a store's build boxes hundreds)."""
+        if not voxels:
+            return {}
+        pts = np.concatenate(list(voxels.values()))
+        starts = np.cumsum([0, *(len(v) for v in voxels.values())])[:-1]
+        half = self.config.resolution_m / 2
+        lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
+        return dict(zip(voxels, zip(lows, highs, strict=True), strict=True))
 
     def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
         vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
