@@ -89,6 +89,11 @@ def test_window_object_goes_indoors_and_unreachable_regions_are_dropped() -> Non
     g2 = builder.build((6.0, 2.0))
     rid = g2.objects["cabinet A"].region_id
     assert rid is not None and g2.regions[rid].centroid[0] < 4.0
+    for node in g2.objects.values():  # an object seen in the map spans its voxels: their centres, half a voxel out
+        pts = builder.voxels.instance_voxels().get(node.instance_id)
+        if pts is not None:
+            half = builder.config.resolution_m / 2
+            assert node.bbox.min == tuple(pts.min(0) - half) and node.bbox.max == tuple(pts.max(0) + half), node.id
 
 
 def test_held_object_leaves_its_region_and_appears_in_hand(explored) -> None:
