@@ -84,9 +84,9 @@ def free_floor_spot(
 
 
 def _overlaps(boxes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Whether footprints (``boxes``: (..., 4) xmin, ymin, xmax, ymax) overlap the box from ``lo`` to ``hi`` (x, y
-    first; either side may hold many). One comparison per side: ``np.all`` over an axis of 2 cost the crowded
-    rooms' draws more than the comparisons themselves."""
+    """Whether footprints (``boxes``: (n, 4) or one (4,) of xmin, ymin, xmax, ymax) overlap the box from ``lo`` to
+    ``hi`` ((2,) corners, or (2, m) for m boxes). One comparison per side: ``np.all`` over an axis of 2 cost the
+    crowded rooms' draws more than the comparisons themselves."""
     return (boxes[..., 0] < hi[0]) & (boxes[..., 1] < hi[1]) & (boxes[..., 2] > lo[0]) & (boxes[..., 3] > lo[1])
 
 
