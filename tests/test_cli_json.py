@@ -108,3 +108,13 @@ def test_listing_commands_import_only_what_they_use(args: list[str]) -> None:
         assert not any(m == "scipy" or m.startswith(("scipy.", "skimage", "networkx")) for m in modules)
     if args[:2] == ["tasks", "show"]:  # shown as defined: nothing instantiated, no world built
         assert not {"more_agent.sim.instantiate", "more_agent.sim.world", "more_agent.sim.scenes"} & modules
+
+
+def test_eval_checks_its_arguments_and_writes_its_reports_without_the_simulator_or_plots(tmp_path: Path) -> None:
+    """The episodes load what they need; the command around them checks --start without the start module
+    (scipy.ndimage) and, with pictures off (the suite's setting), writes its reports without matplotlib."""
+    modules = _imported(["eval", "--tasks", "t1,t2", "--planner", "oracle", "--out", str(tmp_path / "run"),
+                         "--no-progress", "--episode-fn", "tests.eval.fake_episodes:deterministic_episode"])
+    assert "more_agent.eval.report_writer" in modules and (tmp_path / "run" / "summary.md").exists()
+    assert not {m for m in modules if m.startswith(("scipy.ndimage", "matplotlib", "more_agent.sim.start"))} - {
+        "more_agent.sim.start_modes"}

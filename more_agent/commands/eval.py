@@ -101,7 +101,7 @@ def eval_(
     from more_agent.llm.prompts import check_history
     from more_agent.perception_spec import parse_perception
     from more_agent.sim.descriptions import check_description_mode
-    from more_agent.sim.start import check_start
+    from more_agent.sim.start_modes import check_start
     from more_agent.sim.tasks import check_scene_suits
 
     if viewer and episode_fn is not None:

@@ -166,7 +166,7 @@ def run(
     from more_agent.planners.bumble_memory import FailureStore
     from more_agent.records import EpisodeSpec
     from more_agent.sim.descriptions import check_description_mode
-    from more_agent.sim.start import check_start
+    from more_agent.sim.start_modes import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task
 
     load_task(task)  # an unknown task fails first, with the closest names

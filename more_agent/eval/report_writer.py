@@ -8,7 +8,6 @@ from pathlib import Path
 from more_agent.eval.pictures import pictures_enabled
 from more_agent.eval.report import REPORT_HTML, SUMMARY_CSV, SUMMARY_MD, SourcedRecord, summary_csv, summary_markdown
 from more_agent.eval.report_html import render_report
-from more_agent.eval.report_plots import write_plots
 from more_agent.safe_files import write_atomic
 
 
@@ -19,7 +18,11 @@ def write_reports(sourced: Sequence[SourcedRecord], out_dir: Path, *, title: str
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     records = [s.record for s in sourced]
-    plots = write_plots(records, out_dir) if pictures_enabled() else []
+    plots: list[Path] = []
+    if pictures_enabled():
+        from more_agent.eval.report_plots import write_plots  # matplotlib: only when pictures are drawn
+
+        plots = write_plots(records, out_dir)
     paths = [out_dir / SUMMARY_MD, out_dir / SUMMARY_CSV, out_dir / REPORT_HTML]
     figures = "\n".join(f"![{p.stem}]({p.name})" for p in plots)
     write_atomic(paths[0], summary_markdown(records, title=title) + (f"\n## Plots\n\n{figures}\n" if plots else ""))

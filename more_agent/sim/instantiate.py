@@ -55,7 +55,8 @@ from more_agent.sim.matching import maximum_matching
 from more_agent.sim.packing import support_surface
 from more_agent.sim.predicates import NOT_SET_UP, PREDICATES, ROBOT_NAME
 from more_agent.sim.scene import FREE_SPACE_CLASSES, Scene
-from more_agent.sim.start import StartFacts, check_start, random_start, start_facts
+from more_agent.sim.start import StartFacts, random_start, start_facts
+from more_agent.sim.start_modes import check_start
 from more_agent.sim.tasks import (
     TaskDefinition,
     category_phrase,
@@ -110,7 +111,7 @@ class TaskInstance:
     timings: dict[str, float]
     definition: TaskDefinition = field(repr=False)
     start_mode: str = "random"
-    """How the robot's start was chosen (``start.START_MODES``)."""
+    """How the robot's start was chosen (``start_modes.START_MODES``)."""
     distractors: list[str] = field(default_factory=list)
     """World names of the scene's own small objects added as items (``sim.clutter``)."""
     start: StartFacts | None = None

@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
-from more_agent.errors import UserError
 from more_agent.sim.actions import candidate_poses, reach_box, within_reach
 from more_agent.sim.floorspots import PASSAGE_CLEARANCE_M
 from more_agent.sim.navgrid import NavGrid, free_cells, nav_grid, shortest_path
@@ -27,17 +26,6 @@ from more_agent.sim.world import World
 
 MIN_ROOM_FREE_M2 = 1.0
 """A room counts for the per-room start draw when it has at least this much reachable free floor."""
-
-START_MODES = ("random", "random-area", "task-room")
-"""``random`` (default): a reachable room drawn uniformly, then a uniform pose in it; ``random-area``:
-a pose uniform over all reachable free space, so large rooms (stores, gardens) take most starts;
-``task-room``: a free spot in the room of the task's ``(ontop agent floor)`` literal."""
-
-
-def check_start(start: str) -> None:
-    """Raise a UserError naming the valid values when ``start`` is not one of ``START_MODES``."""
-    if start not in START_MODES:
-        raise UserError(f"unknown start {start!r}; use --start with one of: {', '.join(START_MODES)}")
 
 
 @dataclass(frozen=True)
