@@ -259,25 +259,26 @@ class SceneGraphBuilder:
         order = np.argsort(ids, kind="stable")
         ids, pts = ids[order], pts[order]
         starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])  # one run of points per instance
-        half = self.config.resolution_m / 2
-        lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
-        self._glimpsed.update(zip(ids[starts].tolist(), zip(lows, highs, strict=True), strict=True))
+        self._glimpsed.update(zip(ids[starts].tolist(), self._run_boxes(pts, starts), strict=True))
 
     def _voxel_box(self, voxel_centres: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The box (min, max corners) around voxels (n x 3 centres)."""
-        half = self.config.resolution_m / 2
-        return voxel_centres.min(0) - half, voxel_centres.max(0) + half
+        return self._run_boxes(voxel_centres, np.zeros(1, dtype=int))[0]
 
     def _voxel_boxes(self, voxels: Mapping[int, np.ndarray]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-        """``_voxel_box`` of every instance at once: one reduction over all the voxels, not two numpy calls per
-        object (a store's build boxes hundreds)."""
+        """``_voxel_box`` of every instance (id -> n x 3 centres) at once: one reduction over all the voxels, not
+        two numpy calls per object (a store's build boxes hundreds)."""
         if not voxels:
             return {}
-        pts = np.concatenate(list(voxels.values()))
         starts = np.cumsum([0, *(len(v) for v in voxels.values())])[:-1]
+        return dict(zip(voxels, self._run_boxes(np.concatenate(list(voxels.values())), starts), strict=True))
+
+    def _run_boxes(self, pts: np.ndarray, starts: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The box (min, max corners) around each run of points (n x 3) beginning at ``starts``, half a voxel out
+        (a point is a voxel's centre, or a pixel's hit boxed like one)."""
         half = self.config.resolution_m / 2
         lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
-        return dict(zip(voxels, zip(lows, highs, strict=True), strict=True))
+        return list(zip(lows, highs, strict=True))
 
     def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
         vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)

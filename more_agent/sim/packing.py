@@ -151,7 +151,7 @@ def in_space(objs: Sequence[WorldObject], lo: np.ndarray, hi: np.ndarray, z: flo
     centers = np.concatenate([o.center for o in objs]).reshape(-1, 3)
     halves = np.concatenate([o.size for o in objs]).reshape(-1, 3) / 2
     eps = 1e-5  # boxes that merely touch (a card under a barrel's band) do not overlap
-    # the three axes joined one by one: np.all over an axis of 3 cost more than the comparisons
+    # the three axes joined one by one, not np.all over an axis of 3 (cheaper: docs/benchmarks.md, distractor placement)
     meets = (centers - halves < hi3 - eps) & (centers + halves > lo3 + eps)
     return [objs[i] for i in np.flatnonzero(meets[:, 0] & meets[:, 1] & meets[:, 2]).tolist()]
 
