@@ -46,8 +46,11 @@ def is_standing_furniture(category: str) -> bool:
     return catalog.furniture_role(category) != "skip"
 
 
+@cache
 def category_likelihood(category: str, room_type: str) -> float:
-    """Smoothed share of ``room_type``'s furniture that is ``category`` (0 for unknown room types)."""
+    """Smoothed share of ``room_type``'s furniture that is ``category`` (0 for unknown room types). Cached:
+    the grounded planner names the room type of every unlabelled region on every step from all the categories it
+    holds (a store's region holds hundreds), and the inventory's totals cost more than the division."""
     counts = room_type_counts().get(room_type)
     if counts is None:
         return 0.0
