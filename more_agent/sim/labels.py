@@ -84,15 +84,19 @@ class InstanceLabels:
         old place.
         """
         flat = instance.ravel()
-        seen = set(np.flatnonzero(np.bincount(flat)).tolist()) - {0}
+        pixels = np.bincount(flat)  # per instance id
+        seen = set(np.flatnonzero(pixels).tolist()) - {0}
         held = world.robot.held
         if held is not None:
             seen.add(world.objects[held].instance_id)
         by_id = self._objects(world, seen)
         new = [i for i in seen if by_id[i].name not in self._labels and by_id[i].kind != "floor"]
         if new:  # first observations get their labels in reading order of the image
-            ids, first = np.unique(flat, return_index=True)
-            order = {int(i): int(k) for i, k in zip(ids, first)}
+            is_new = np.zeros(pixels.size, dtype=bool)
+            is_new[[i for i in new if i < pixels.size]] = True
+            at = np.flatnonzero(is_new[flat])  # only the new ones' pixels are sorted, not the whole image's
+            ids, first = np.unique(flat[at], return_index=True)
+            order = dict(zip(ids.tolist(), at[first].tolist()))
             self.observe(by_id[i] for i in sorted(new, key=lambda i: (order.get(i, -1), i)))
         return {
             i: {

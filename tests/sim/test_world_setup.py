@@ -198,6 +198,19 @@ def test_labels_follow_observation_and_reveal_no_unseen_instance() -> None:
     assert all(labels.label(o.name) == "" and labels.display(o) == o.category for o in unseen)
 
 
+def test_what_one_frame_shows_first_is_labelled_in_reading_order_of_its_first_pixels() -> None:
+    """Two countertops first seen in the same frame: the one whose first pixel comes first (row by row) is A,
+    however the instance ids run."""
+    inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2)
+    world, labels = inst.world, inst.labels
+    low, high = sorted((world.get("countertop_0"), world.get("countertop_1")), key=lambda o: o.instance_id)
+    image = np.zeros((3, 4), dtype=np.int32)
+    image[1, 3], image[2, 0], image[2, 2] = high.instance_id, low.instance_id, high.instance_id
+    table = labels.table(world, image)
+    assert (labels.label(high.name), labels.label(low.name)) == ("countertop A", "countertop B")
+    assert set(table) == {low.instance_id, high.instance_id}
+
+
 def test_assign_all_labels_the_rest_after_the_reserved() -> None:
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=2)
     inst.labels.assign_all(inst.world)
