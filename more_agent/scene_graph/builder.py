@@ -87,6 +87,10 @@ class SceneGraphBuilder:
         self._remembered: set[int] = set()
         self._carried: set[int] = set()
         """Instances resting on or in the held one (directly or through others): they travel with it."""
+        self._carried_current = False
+        """Whether ``_carried`` follows from the instances as they are (``_pick_up_contents``)."""
+        self._held: set[int] = set()
+        """The instances held now (by what perception last said of each)."""
         self._glimpsed: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         """Instance id -> box of its pixels when last in view small (used while the voxel map has none of it)."""
         self._anchors: dict[str, np.ndarray] = {}
@@ -128,8 +132,15 @@ class SceneGraphBuilder:
                 self._lift(iid)  # the leaf swung: what was seen of it no longer blocks, but the door is still
                 if iid in self._boxes:  # there, in the state the robot knows, until seen again
                     self._remembered.add(iid)
+            if previous is None or (info.label, info.rests, info.held) != (
+                previous.label,
+                previous.rests,
+                previous.held,
+            ):
+                self._carried_current = False
             self._instances[iid] = info
-        held_now = [iid for iid, info in self._instances.items() if info.held]
+            (self._held.add if info.held else self._held.discard)(iid)
+        held_now = sorted(self._held)
         self._pick_up_contents(holding=bool(held_now))
         for iid in self._carried & set(self._boxes):  # with the robot, where this frame was taken
             lo, hi = self._boxes[iid]
@@ -137,18 +148,24 @@ class SceneGraphBuilder:
             self._boxes[iid] = (lo + shift, hi + shift)
         held = held_now + sorted(self._carried)
         self.voxels.integrate(depth, semantic, instance, K, T_world_cam, ignore_instances=held)
-        self._glimpse(depth, instance, K, T_world_cam, held)
+        hits = np.flatnonzero(np.isfinite(depth) & (instance > 0))  # the pixels that show an instance
+        ids = instance.ravel()[hits]
+        pixels = np.bincount(ids)  # per instance id
+        self._glimpse(depth, hits, ids, pixels, K, T_world_cam, held)
         xy = (float(robot_xy[0]), float(robot_xy[1]))
         key = (round(xy[0] / self.config.viewpoint_spacing_m), round(xy[1] / self.config.viewpoint_spacing_m))
-        for iid in np.flatnonzero(np.bincount(instance[np.isfinite(depth)].ravel())).tolist():  # ids in view
-            if iid > 0:
-                self._viewpoints.setdefault(iid, {})[key] = xy
+        for iid in np.flatnonzero(pixels).tolist():  # the instances in view
+            self._viewpoints.setdefault(iid, {})[key] = xy
 
     def _pick_up_contents(self, *, holding: bool) -> None:
         """Update which instances ride on the held one (perception says what each rests on / in), when
         ``holding`` something. Newly carried ones leave the voxel map like the held one (seen in the
         robot's hand, they would map as an obstacle where the robot stands) and are kept in the graph,
-        travelling with the robot."""
+        travelling with the robot. Skipped while what it reads (labels, supports, held) has not changed since it
+        last ran holding something: it walks every instance known, and a store's robot knows hundreds."""
+        if holding and self._carried_current:
+            return
+        self._carried_current = holding
         carried: set[int] = set()
         by_label = {info.label: iid for iid, info in self._instances.items()} if holding else {}
         for iid, info in self._instances.items() if holding else ():
@@ -237,23 +254,30 @@ class SceneGraphBuilder:
 
     # ---------------------------------------------------------------- helpers
     def _glimpse(
-        self, depth: np.ndarray, instance: np.ndarray, K: np.ndarray, T_world_cam: np.ndarray, held: Sequence[int]
+        self,
+        depth: np.ndarray,
+        hits: np.ndarray,
+        ids: np.ndarray,
+        pixels: np.ndarray,
+        K: np.ndarray,
+        T_world_cam: np.ndarray,
+        held: Sequence[int],
     ) -> None:
-        """Box the small instances in view from their own pixels. A small item on a support shares its
-        voxels with the support's surface (7.5 cm voxels, an egg is 5 cm tall), and the surface's hits
-        overwrite it: without this the map loses it even while the robot looks at it."""
-        valid = np.isfinite(depth) & (instance > 0)
-        counts = np.bincount(instance[valid].ravel())
-        small = np.flatnonzero((counts > 0) & (counts <= GLIMPSE_MAX_PIXELS))
-        small = small[~np.isin(small, held)]
-        if small.size == 0:
+        """Box the small instances in view from their own pixels (``hits``: the flat indices of the pixels that show
+        an instance, in reading order; ``ids``: its id at each; ``pixels``: how many each id has). A small item on
+        a support shares its voxels with the support's surface (7.5 cm voxels, an egg is 5 cm tall), and the
+        surface's hits overwrite it: without this the map loses it even while the robot looks at it."""
+        small = (pixels > 0) & (pixels <= GLIMPSE_MAX_PIXELS)
+        small[[i for i in held if i < small.size]] = False
+        if not small.any():
             return
-        v, u = np.nonzero(valid & np.isin(instance, small))
+        take = small[ids]
+        v, u = np.divmod(hits[take], depth.shape[1])
         d = depth[v, u].astype(float)
         cam = np.stack([(u + 0.5 - K[0, 2]) / K[0, 0] * d, (v + 0.5 - K[1, 2]) / K[1, 1] * d, d], axis=1)
         inside = np.einsum("ij,ij->i", cam, cam) <= self.config.max_range_m**2
         pts = cam[inside] @ T_world_cam[:3, :3].T + T_world_cam[:3, 3]
-        ids = instance[v, u][inside]
+        ids = ids[take][inside]
         if ids.size == 0:
             return
         order = np.argsort(ids, kind="stable")

@@ -9,7 +9,7 @@ import numpy as np
 
 from more_agent.sim.scene import STRUCTURAL_CLASSES
 
-CLASSES = [*STRUCTURAL_CLASSES, "table", "cabinet", "apple"]
+CLASSES = [*STRUCTURAL_CLASSES, "table", "cabinet", "apple", "basket"]
 CID = {name: i for i, name in enumerate(CLASSES)}
 
 

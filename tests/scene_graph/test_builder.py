@@ -107,6 +107,27 @@ def test_held_object_leaves_its_region_and_appears_in_hand(explored) -> None:
     assert g.objects["apple A"].region_id is None
     assert all(o.id != "apple A" for rid in g.regions for o in g.objects_in(rid))
     assert not any(r.subject == "apple A" for r in g.relations)
+    explore(builder, boxes, infos, [(2.0, 2.0)], n_yaw=8)  # put back: the frames map it again
+    assert 4 in builder.voxels.instance_voxels() and builder.build((2.0, 2.0)).held_object is None
+
+
+def test_what_is_first_said_to_rest_on_the_held_item_after_the_grasp_travels_with_it() -> None:
+    """Perception may say only after the grasp that an item rests on the held one (the builder worked out what
+    rides along at the grasp, and must not keep that answer): from then on the item leaves the voxel map and
+    its box travels with the robot."""
+    boxes, infos = two_rooms(cabinet=False)
+    boxes += [Box((1.5, 2.9, 0.75), (1.75, 3.2, 0.95), "basket", 6), Box((1.55, 2.95, 0.95), (1.7, 3.1, 1.1), "apple", 7)]
+    infos = {**infos, 6: InstanceInfo(label="basket A", category="basket"), 7: InstanceInfo(label="apple B", category="apple")}
+    builder = new_builder()
+    explore(builder, boxes, infos, [(1.4, 2.0)], n_yaw=8)
+    grasped = {**infos, 6: InstanceInfo(label="basket A", category="basket", held=True)}
+    explore(builder, boxes, grasped, [(1.4, 2.0)], n_yaw=1)
+    assert 7 in builder.voxels.instance_voxels()  # nothing said it lies on the basket yet
+    told = {**grasped, 7: InstanceInfo(label="apple B", category="apple", rests=("ontop", "basket A"))}
+    explore(builder, boxes, told, [(3.0, 2.0)], n_yaw=1)
+    assert 7 not in builder.voxels.instance_voxels()
+    apple = builder.build((3.0, 2.0)).objects["apple B"]
+    assert math.dist(apple.position[:2], (3.0, 2.0)) < 1e-6, apple.position
 
 
 def test_frontiers_point_into_unexplored_space() -> None:
