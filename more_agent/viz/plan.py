@@ -10,13 +10,14 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.collections import PatchCollection  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
 from more_agent.sim.scene import Scene  # noqa: E402
 
@@ -26,9 +27,11 @@ _OPEN_DOOR, _CLOSED_DOOR = "#2ca02c", "#d62728"
 _FURNITURE, _OPENABLE = "#8c6d46", "#c7822b"
 
 
-def _rects(bounds, **kw) -> PatchCollection:
-    """Axis-aligned boxes (x0, y0, x1, y1) as one collection: a store's hundreds of boxes draw in one call."""
-    return PatchCollection([Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1]) for b in bounds], **kw)
+def _rects(bounds, **kw) -> PolyCollection:
+    """Axis-aligned boxes (x0, y0, x1, y1) as one collection of corner arrays: a store's hundreds of boxes draw
+    in one call, and no patch object is made per box (they cost a tenth of an episode map; the same pixels)."""
+    b = np.asarray(bounds, dtype=float).reshape(-1, 4)
+    return PolyCollection(np.stack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]], axis=1), **kw)
 
 
 def draw_plan(
