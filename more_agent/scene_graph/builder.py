@@ -242,7 +242,7 @@ class SceneGraphBuilder:
             config=self.config,
         )
         region_ids = self._stable_ids(rg.graph, rg.labels)
-        path = _densified(self._retraceable(path_xy, occ, grid), grid.resolution_m)
+        path = grid.passed(self._retraceable(path_xy, occ, grid))
         keep = self._robot_component(rg.graph, robot, blocked, grid, path)
         frontier_node = self._attach(rg.graph, rg.labels, rg.frontier_xy, blocked, grid)
         frontier_node = self._through_openings(rg.graph, rg.labels, keep, rg.frontier_xy, frontier_node, occ, grid)

@@ -116,3 +116,25 @@ class Grid:
         """
         (x0, y0), res = self.origin_xy, self.resolution_m
         return float(x0), float(y0), float(x0 + shape[0] * res), float(y0 + shape[1] * res)
+
+    def passed(self, path: ArrayLike) -> np.ndarray:
+        """The points (n x 2) a polyline ``path`` passes within a cell of: its vertices, then, for each segment
+        longer than a cell (in segment order), points at most a cell apart between its ends. A magic action's
+        approach adds only its waypoints to a path, metres apart, and the robot passed every point between them.
+        Only the long segments are visited: a robot's path has a vertex for every step it drove.
+
+        Examples
+        --------
+        >>> Grid(resolution_m=0.5).passed([[0.0, 0.0], [0.2, 0.0], [1.2, 0.0]])
+        array([[0. , 0. ],
+               [0.2, 0. ],
+               [1.2, 0. ],
+               [0.7, 0. ]])
+        """
+        points = np.asarray(path, dtype=float).reshape(-1, 2)
+        steps = np.diff(points, axis=0)
+        counts = np.ceil(np.abs(steps).max(axis=1) / self.resolution_m).astype(int)
+        between = [
+            points[i] + steps[i] * (np.arange(1, counts[i])[:, None] / counts[i]) for i in np.flatnonzero(counts > 1)
+        ]
+        return np.concatenate([points, *between]) if between else points

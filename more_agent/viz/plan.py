@@ -31,7 +31,8 @@ def _rects(bounds, **kw) -> PolyCollection:
     """Axis-aligned boxes (x0, y0, x1, y1) as one collection of corner arrays: a store's hundreds of boxes draw
     in one call, and no patch object is made per box (they cost a tenth of an episode map; the same pixels)."""
     b = np.asarray(bounds, dtype=float).reshape(-1, 4)
-    return PolyCollection(np.stack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]], axis=1), **kw)
+    corners = np.stack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]], axis=1)
+    return PolyCollection(corners, **kw)  # type: ignore[arg-type]  # an (n, 4, 2) array: matplotlib takes it whole
 
 
 def draw_plan(

@@ -93,13 +93,8 @@ def _grown_box(mask: np.ndarray, margin: int) -> tuple[slice, slice] | None:
 
 
 def _path_cells(occupancy: OccupancyMap, path: Sequence[XY]) -> np.ndarray:
-    """(n, 2) cells the polyline ``path`` passes through: a magic action's approach adds its waypoints
-    only, metres apart, and the robot stood on every cell between them too."""
-    points = np.asarray(path, dtype=float).reshape(-1, 2)
-    steps = np.diff(points, axis=0)
-    counts = np.ceil(np.abs(steps).max(axis=1) / occupancy.resolution_m).astype(int)
-    between = [points[i] + steps[i] * (np.arange(1, n)[:, None] / n) for i, n in enumerate(counts) if n > 1]
-    return _cells(occupancy, np.concatenate([points, *between]) if between else points)
+    """(n, 2) cells the polyline ``path`` passes through (``Grid.passed``)."""
+    return _cells(occupancy, occupancy.frame.passed(path))
 
 
 def _cells(occupancy: OccupancyMap, points: Sequence[XY] | np.ndarray) -> np.ndarray:
