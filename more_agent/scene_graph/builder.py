@@ -231,7 +231,7 @@ class SceneGraphBuilder:
         doors = [voxels[i][:, :2] for i in known if i in voxels and self._instances[i].category == "door"]
         objects = [i for i in known if not self._instances[i].held]
         centres = np.array([(boxes[i][0] + boxes[i][1]) / 2 for i in objects]).reshape(-1, 3)
-        viewpoints = np.array([self._closest_viewpoint(i, c[:2]) for i, c in zip(objects, centres)]).reshape(-1, 2)
+        viewpoints = self._closest_viewpoints(objects, centres[:, :2])
         rg = region_graph(
             occ,
             grid,
@@ -304,9 +304,20 @@ class SceneGraphBuilder:
         lows, highs = np.minimum.reduceat(pts, starts) - half, np.maximum.reduceat(pts, starts) + half
         return list(zip(lows, highs, strict=True))
 
-    def _closest_viewpoint(self, iid: int, xy: np.ndarray) -> np.ndarray:
-        vps = np.array(list(self._viewpoints.get(iid, {}).values())).reshape(-1, 2)
-        return xy if len(vps) == 0 else vps[np.argmin(np.linalg.norm(vps - xy, axis=1))]
+    def _closest_viewpoints(self, objects: Sequence[int], xy: np.ndarray) -> np.ndarray:
+        """Per object, the robot position it was seen from nearest to its ``xy`` row (the first of equals; that
+        row itself when none is known), for all objects at once: a store's build has hundreds."""
+        seen = [list(self._viewpoints.get(i, {}).values()) for i in objects]
+        counts = np.array([len(v) for v in seen], dtype=int)
+        closest = np.array(xy, dtype=float).reshape(-1, 2)
+        if not counts.any():
+            return closest
+        points = np.array([p for v in seen for p in v], dtype=float)
+        owner = np.repeat(np.arange(len(seen)), counts)
+        nearest_first = np.lexsort((np.linalg.norm(points - closest[owner], axis=1), owner))  # stable: ties by order
+        known = counts > 0
+        closest[known] = points[nearest_first[(np.cumsum(counts) - counts)[known]]]
+        return closest
 
     def _nearest_visible(self, graph: NavGraph, nodes: np.ndarray, p: np.ndarray, blocked, grid: Grid) -> int:
         """Index (into graph) of the closest of ``nodes`` seeing p, else the closest; -1 if none."""
@@ -550,14 +561,3 @@ def _patch_at(patches: np.ndarray, grid: Grid, points: np.ndarray) -> np.ndarray
     out = np.zeros(len(cells), dtype=patches.dtype)
     out[on] = patches[cells[on, 0], cells[on, 1]]
     return out
-
-
-def _densified(path: np.ndarray, spacing_m: float) -> np.ndarray:
-    """The polyline ``path`` (n x 2) with points added every ``spacing_m`` or less between its vertices: a
-    magic action's approach adds waypoints metres apart, and the robot passed every point between them."""
-    if len(path) < 2:
-        return path
-    steps = np.diff(path, axis=0)
-    counts = np.ceil(np.abs(steps).max(axis=1) / spacing_m).astype(int)
-    between = [path[i] + steps[i] * (np.arange(1, n)[:, None] / n) for i, n in enumerate(counts) if n > 1]
-    return np.concatenate([path, *between]) if between else path

@@ -130,6 +130,23 @@ def test_what_is_first_said_to_rest_on_the_held_item_after_the_grasp_travels_wit
     assert math.dist(apple.position[:2], (3.0, 2.0)) < 1e-6, apple.position
 
 
+def test_each_object_reads_the_position_it_was_seen_from_nearest_to_it() -> None:
+    """Eq. 1's viewpoint of an object: of the robot positions it was seen from, the nearest to it (the first
+    of equals); its own position while none is known."""
+    boxes, infos = two_rooms()
+    builder = new_builder()
+    explore(builder, boxes, infos, [(1.0, 1.0), (3.0, 1.0)], n_yaw=6)
+    table_seen = list(builder._viewpoints[3].values())
+    assert {(1.0, 1.0), (3.0, 1.0)} <= set(table_seen)
+    objects = [3, 2, 4, 99]  # 99: never seen
+    xy = np.array([[2.0, 3.2], [3.7, 0.6], [1.4, 3.2], [5.0, 5.0]])  # the table's point is as far from both
+    got = builder._closest_viewpoints(objects, xy)
+    assert tuple(got[0]) == (1.0, 1.0)  # the first of equals
+    for k, iid in enumerate(objects):
+        seen = list(builder._viewpoints.get(iid, {}).values())
+        assert tuple(got[k]) == (min(seen, key=lambda p: math.dist(p, xy[k])) if seen else tuple(xy[k]))
+
+
 def test_frontiers_point_into_unexplored_space() -> None:
     boxes, infos = two_rooms()
     builder = new_builder(max_range_m=2.5)
