@@ -1,6 +1,8 @@
 """Suite-wide settings: episodes and reports are written without their matplotlib pictures
 (``MORE_AGENT_PICTURES=0``, set here so that ``more-agent`` subprocesses inherit it too), which cost more
-than most fixture episodes; tests that look at a picture ask for ``pictures_on``. Typer's ``CliRunner`` builds
+than most fixture episodes; tests that look at a picture ask for ``pictures_on``. Worlds are built afresh
+(``MORE_AGENT_WORLD_CACHE=off``): a test that patches how worlds are built must get the world it built, and
+the suite writes nothing to the user's cache; the cache's own tests give it a file. Typer's ``CliRunner`` builds
 the click command of the app it invokes once per test process, not on every call (``_command_once``). ``-n auto`` starts one
 pytest-xdist worker more than the machine has cores (``pytest_xdist_auto_num_workers``)."""
 
@@ -13,8 +15,10 @@ import pytest
 import typer.testing
 
 from more_agent.eval.pictures import ENV_PICTURES
+from more_agent.sim.world_cache import ENV_WORLD_CACHE
 
 os.environ.setdefault(ENV_PICTURES, "0")
+os.environ.setdefault(ENV_WORLD_CACHE, "off")
 
 
 @cache

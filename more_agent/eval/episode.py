@@ -110,7 +110,7 @@ def run_episode(
     from more_agent.llm.errors import LLMError
     from more_agent.perception.model import perception_for
     from more_agent.sim.goals import GoalChecker
-    from more_agent.sim.instantiate import instantiate
+    from more_agent.sim.world_cache import instantiate_cached
 
     clock = _Clock()
     record = EpisodeRecord.for_spec(spec)
@@ -135,7 +135,7 @@ def run_episode(
         folder.clear()  # an earlier episode's steps and frames must never show in this one's viewer
     try:
         t = time.perf_counter()
-        instance = instantiate(
+        instance = instantiate_cached(
             spec.task,
             spec.scene,
             spec.seed,

@@ -1,0 +1,132 @@
+"""Instantiated worlds kept on disk: every planner of a sweep runs on the worlds the first one built.
+
+A task instance (:func:`~more_agent.sim.instantiate.instantiate`) is a function of its arguments, of the
+scene file it names (when it names one) and of the code and data that build it. The cache keys each
+instance by a sha256 over all of them: the arguments, the scene file's bytes, and a fingerprint of this
+package's files and of the versions of Python, numpy, scipy and bddl (their random streams and task
+files). A world built by other code is never read; rows of another fingerprint are dropped on the first
+write. Instances are pickled into one sqlite file that parallel workers share (a busy timeout; each
+process opens its own connection).
+
+Building a world is about a tenth of a grounded episode and most of an oracle one (docs/benchmarks.md);
+a sweep of seven planners over 165 worlds builds each once. ``MORE_AGENT_WORLD_CACHE`` names the file
+(default ``~/.cache/more-agent/worlds.sqlite``), or ``off``. The cache never costs an episode: a file it
+cannot read or write, or a row it cannot load, is logged and the world is built as without it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import pickle
+import sqlite3
+import sys
+from contextlib import closing
+from functools import cache
+from importlib.metadata import version
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from more_agent.sim.instantiate import TaskInstance
+
+ENV_WORLD_CACHE = "MORE_AGENT_WORLD_CACHE"
+"""The cache's sqlite file, or ``off``."""
+
+DEFAULT_WORLD_CACHE = Path.home() / ".cache" / "more-agent" / "worlds.sqlite"
+
+BUSY_TIMEOUT_S = 30.0
+"""How long a worker waits for another's write (a row is a few hundred kB)."""
+
+log = logging.getLogger(__name__)
+
+
+def world_cache_path() -> Path | None:
+    """The cache file ``MORE_AGENT_WORLD_CACHE`` names (the default when unset), None when it says ``off``."""
+    value = os.environ.get(ENV_WORLD_CACHE, "").strip()
+    if value.lower() == "off":
+        return None
+    return Path(value).expanduser() if value else DEFAULT_WORLD_CACHE
+
+
+@cache
+def code_fingerprint() -> str:
+    """sha256 over this package's source and data files and the versions of what builds a world with it."""
+    digest = hashlib.sha256()
+    root = Path(__file__).resolve().parents[1]
+    for path in sorted(p for p in root.rglob("*") if p.suffix in (".py", ".json") and "__pycache__" not in p.parts):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    versions = [sys.version, *(version(name) for name in ("numpy", "scipy", "bddl"))]
+    digest.update(json.dumps(versions).encode())
+    return digest.hexdigest()
+
+
+def instance_key(task: str, scene: str | None, seed: int, *, start: str, distractors: bool, descriptions: str) -> str:
+    """The cache key of an instance: its arguments, the bytes of a scene file, the code fingerprint."""
+    scene_bytes = Path(scene).read_bytes() if scene is not None and scene.endswith(".json") else b""
+    fields = [code_fingerprint(), task, scene, seed, start, distractors, descriptions]
+    return hashlib.sha256(json.dumps(fields).encode() + b"\0" + scene_bytes).hexdigest()
+
+
+def instantiate_cached(
+    task: str,
+    scene: str | None = None,
+    seed: int = 0,
+    *,
+    start: str = "random",
+    distractors: bool = True,
+    descriptions: str = "named",
+) -> TaskInstance:
+    """:func:`~more_agent.sim.instantiate.instantiate`, reading the instance from the world cache when it
+    holds it and writing it there when not. Bad input raises as ``instantiate`` does (nothing is cached)."""
+    from more_agent.sim.instantiate import instantiate
+
+    path = world_cache_path()
+    if path is None:
+        return instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+    try:
+        key = instance_key(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+    except OSError:  # an unreadable scene file: instantiate says what is wrong with it
+        return instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+    cached = _read(path, key)
+    if cached is not None:
+        return cached
+    instance = instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+    _write(path, key, instance)
+    return instance
+
+
+def _connect(path: Path) -> sqlite3.Connection:
+    connection = sqlite3.connect(path, timeout=BUSY_TIMEOUT_S, isolation_level=None)
+    connection.execute(
+        "CREATE TABLE IF NOT EXISTS worlds (key TEXT PRIMARY KEY, fingerprint TEXT NOT NULL, instance BLOB NOT NULL)"
+    )
+    return connection
+
+
+def _read(path: Path, key: str) -> TaskInstance | None:
+    from more_agent.sim.instantiate import TaskInstance
+
+    if not path.is_file():
+        return None
+    try:
+        with closing(_connect(path)) as connection:
+            row = connection.execute("SELECT instance FROM worlds WHERE key = ?", (key,)).fetchone()
+        instance = pickle.loads(row[0]) if row is not None else None
+    except Exception as e:  # noqa: BLE001 - a cache that fails is a cache miss, never a lost episode
+        log.warning("world cache %s unreadable, building the world: %s: %s", path, type(e).__name__, e)
+        return None
+    return instance if isinstance(instance, TaskInstance) else None
+
+
+def _write(path: Path, key: str, instance: TaskInstance) -> None:
+    try:
+        blob = pickle.dumps(instance, protocol=pickle.HIGHEST_PROTOCOL)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with closing(_connect(path)) as connection:
+            connection.execute("DELETE FROM worlds WHERE fingerprint != ?", (code_fingerprint(),))
+            connection.execute("INSERT OR REPLACE INTO worlds VALUES (?, ?, ?)", (key, code_fingerprint(), blob))
+    except Exception as e:  # noqa: BLE001 - the episode goes on with the world it built
+        log.warning("world cache %s not written: %s: %s", path, type(e).__name__, e)
