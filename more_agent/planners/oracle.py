@@ -32,7 +32,8 @@ from more_agent.scene_graph import SceneGraph
 from more_agent.sim.actions import approach_rounds, distance_to_footprint
 from more_agent.sim.env import ACTION_TYPES
 from more_agent.sim.goals import GoalChecker, PrivilegedContext, literal_holds
-from more_agent.sim.navgrid import blocking_door, nav_grid, shortest_path
+from more_agent.sim.navgrid import blocking_door, nav_grid
+from more_agent.sim.paths import reaches
 from more_agent.sim.world import World, WorldObject
 from more_agent.skills import skill_named
 from more_agent.vocabulary import RELATIONS
@@ -278,7 +279,7 @@ class OraclePlanner:
         """A closed door between where ``subject`` is and where ``target`` can be reached from."""
         start = next((p for poses in approach_rounds(self._world, subject) for p in poses), None)
         goals = [p for poses in approach_rounds(self._world, target) for p in poses]
-        if start is None or not goals or shortest_path(nav_grid(self._world), start, goals).found:
+        if start is None or not goals or reaches(nav_grid(self._world), start, goals):
             return None
         return blocking_door(self._world, start, goals)
 

@@ -25,7 +25,7 @@ from scipy import ndimage
 from more_agent.robot import XY
 from more_agent.robot_spec import ROBOT
 from more_agent.sim.grid import Grid
-from more_agent.sim.paths import NavGrid, shortest_path
+from more_agent.sim.paths import NavGrid, reaches, shortest_path
 from more_agent.sim.scene import Bounds2D, Door
 from more_agent.sim.world import World
 
@@ -165,4 +165,4 @@ def blocking_door(world: World, start: XY, goals: Sequence[XY], config: NavConfi
 
 def reachable(world: World, start: XY, goal: XY, config: NavConfig = DEFAULT_NAV) -> bool:
     """Whether the robot can drive from ``start`` to ``goal`` with the doors as they are."""
-    return shortest_path(nav_grid(world, config), start, [goal]).found
+    return reaches(nav_grid(world, config), start, [goal])

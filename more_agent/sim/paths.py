@@ -70,6 +70,12 @@ class NavGrid(Grid):
         return MCP_Geometric(np.where(self.free.T, 1.0, np.inf))
 
     @cached_property
+    def _components(self) -> np.ndarray:
+        """The connected components of the free cells (0 elsewhere), with the eight neighbours the path search
+        steps to: two free cells are joined by a path exactly when they share a label."""
+        return ndimage.label(self.free, structure=np.ones((3, 3), dtype=bool))[0]
+
+    @cached_property
     def _nearest_free(self) -> tuple[np.ndarray, np.ndarray]:
         # y-major, see the module docstring
         iys, ixs = ndimage.distance_transform_edt(~self.free.T, return_distances=False, return_indices=True)
@@ -148,6 +154,19 @@ def simplify_polyline(points: np.ndarray, tolerance: float) -> np.ndarray:
             keep[split] = True
             spans += [(split, end), (start, split)]
     return points[keep]
+
+
+def reaches(grid: NavGrid, start: XY, goals: Sequence[XY]) -> bool:
+    """Whether :func:`shortest_path` finds a path from ``start`` to one of ``goals``, without searching for it:
+    the snapped start and a free goal lie in one component of the free cells. A privileged planner asks this
+    of a world's grid many times (is a closed door in the way?), and a search costs milliseconds."""
+    start_cell = grid.snap(*start)
+    if start_cell is None:
+        return False
+    components = grid._components
+    label = components[start_cell[0], start_cell[1]]
+    cells = [grid.cell_at(*goals[i]) for i in np.flatnonzero(grid.free_at(goals)).tolist()]
+    return any(components[ix, iy] == label for ix, iy in cells)
 
 
 def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:

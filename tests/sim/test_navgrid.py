@@ -8,6 +8,7 @@ import numpy as np
 
 from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import NavConfig, blocking_door, free_cells, nav_grid, reachable, shortest_path
+from more_agent.sim.paths import NavGrid, reaches
 from more_agent.sim.scene import Door, Furniture, Room, Scene, Wall
 from more_agent.sim.world import World, WorldObject
 
@@ -16,20 +17,48 @@ def two_room_scene(door_open: bool = True, door_width: float = 0.9) -> Scene:
     """Kitchen (x 0..4.95) and living room (x 5.05..10), 4 m deep, joined by one door at (5, 2)."""
     half = door_width / 2
     return Scene(
-        name="two_rooms", bounds=(-0.1, -0.1, 10.1, 4.1),
-        rooms=[Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4.95, 4)),
-               Room(id="living_room_0", type="living_room", bounds=(5.05, 0, 10, 4))],
-        walls=[Wall(bounds=(-0.1, -0.1, 10.1, 0)), Wall(bounds=(-0.1, 4, 10.1, 4.1)),
-               Wall(bounds=(-0.1, 0, 0, 4)), Wall(bounds=(10, 0, 10.1, 4)),
-               Wall(bounds=(4.95, 0, 5.05, 2 - half)), Wall(bounds=(4.95, 2 + half, 5.05, 4))],
-        doors=[Door(id="door_0", rooms=("kitchen_0", "living_room_0"), center=(5, 2), width=door_width, axis="y",
-                    open=door_open)],
+        name="two_rooms",
+        bounds=(-0.1, -0.1, 10.1, 4.1),
+        rooms=[
+            Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4.95, 4)),
+            Room(id="living_room_0", type="living_room", bounds=(5.05, 0, 10, 4)),
+        ],
+        walls=[
+            Wall(bounds=(-0.1, -0.1, 10.1, 0)),
+            Wall(bounds=(-0.1, 4, 10.1, 4.1)),
+            Wall(bounds=(-0.1, 0, 0, 4)),
+            Wall(bounds=(10, 0, 10.1, 4)),
+            Wall(bounds=(4.95, 0, 5.05, 2 - half)),
+            Wall(bounds=(4.95, 2 + half, 5.05, 4)),
+        ],
+        doors=[
+            Door(
+                id="door_0",
+                rooms=("kitchen_0", "living_room_0"),
+                center=(5, 2),
+                width=door_width,
+                axis="y",
+                open=door_open,
+            )
+        ],
         furniture=[
-            Furniture(id="fridge_0", category="fridge", room="kitchen_0", center=(0.45, 3.5, 0.9), size=(0.8, 0.8, 1.8),
-                      openable=True),
+            Furniture(
+                id="fridge_0",
+                category="fridge",
+                room="kitchen_0",
+                center=(0.45, 3.5, 0.9),
+                size=(0.8, 0.8, 1.8),
+                openable=True,
+            ),
             Furniture(id="table_0", category="table", room="living_room_0", center=(7.5, 2, 0.4), size=(1.5, 0.9, 0.8)),
-            Furniture(id="cabinet_0", category="bottom_cabinet", room="living_room_0", center=(9.6, 0.4, 0.45),
-                      size=(0.7, 0.7, 0.9), openable=True),
+            Furniture(
+                id="cabinet_0",
+                category="bottom_cabinet",
+                room="living_room_0",
+                center=(9.6, 0.4, 0.45),
+                size=(0.7, 0.7, 0.9),
+                openable=True,
+            ),
         ],
     )
 
@@ -56,11 +85,11 @@ def labelled(world: World) -> InstanceLabels:
 def test_free_space_excludes_walls_furniture_and_keeps_clearance():
     grid = nav_grid(two_room_world())
     assert grid.is_free(2.5, 1.0)
-    assert not grid.is_free(5.0, 1.0)          # wall
-    assert not grid.is_free(7.5, 2.0)          # table
-    assert not grid.is_free(7.5, 2.45 + 0.1)   # within the robot radius of the table
+    assert not grid.is_free(5.0, 1.0)  # wall
+    assert not grid.is_free(7.5, 2.0)  # table
+    assert not grid.is_free(7.5, 2.45 + 0.1)  # within the robot radius of the table
     assert grid.is_free(7.5, 2.45 + 0.35)
-    assert not grid.is_free(20.0, 2.0)         # outside the scene
+    assert not grid.is_free(20.0, 2.0)  # outside the scene
 
 
 def test_a_footprint_thinner_than_a_cell_blocks_the_grid_as_it_blocks_the_base():
@@ -72,8 +101,13 @@ def test_a_footprint_thinner_than_a_cell_blocks_the_grid_as_it_blocks_the_base()
     x0, x1 = centre + 0.3 * res, centre + 0.6 * res  # between that column and the next
     scene = two_room_scene()
     scene.furniture.append(
-        Furniture(id="room_divider_0", category="room_divider", room="living_room_0",
-                  center=((x0 + x1) / 2, 2.0, 0.9), size=(x1 - x0, 4.0, 1.8))
+        Furniture(
+            id="room_divider_0",
+            category="room_divider",
+            room="living_room_0",
+            center=((x0 + x1) / 2, 2.0, 0.9),
+            size=(x1 - x0, 4.0, 1.8),
+        )
     )
     world = World.from_scene(scene)
     world.set_robot_pose(2.5, 1.0, 0.0)
@@ -117,6 +151,31 @@ def test_a_grid_searched_again_finds_what_a_fresh_grid_finds():
     again = shortest_path(grid, (2.5, 1.0), [(9.0, 3.5), (6.0, 1.0)])
     fresh = shortest_path(nav_grid(two_room_world()), (2.5, 1.0), [(9.0, 3.5), (6.0, 1.0)])
     assert again.found and again == fresh
+
+
+def test_reaches_says_what_the_search_finds_without_searching():
+    """``reaches`` (components of the free cells) against ``shortest_path(...).found`` (the search itself) on
+    random rasters: corridors that touch only at a corner, starts off the free cells (snapped), goals off the
+    free cells or off the grid."""
+    corner = np.zeros((4, 4), dtype=bool)  # two free cells that touch only at a corner: the search steps across
+    corner[1, 1] = corner[2, 2] = True
+    rng = np.random.default_rng(7)
+    for trial in range(60):
+        free = corner if trial == 0 else rng.random((int(rng.integers(3, 25)), int(rng.integers(3, 25)))) < 0.5
+        grid = NavGrid(origin_xy=(-1.0, 2.0), resolution_m=0.5, free=free, closed_doors=frozenset(), door_cells={})
+        x1, y1 = -1.0 + 0.5 * free.shape[0], 2.0 + 0.5 * free.shape[1]
+        for _ in range(10):
+            start = (float(rng.uniform(-1.0, x1)), float(rng.uniform(2.0, y1)))
+            goals = [
+                (float(rng.uniform(-2.0, x1 + 1)), float(rng.uniform(1.0, y1 + 1))) for _ in range(rng.integers(0, 4))
+            ]
+            assert reaches(grid, start, goals) == shortest_path(grid, start, goals).found, (trial, start, goals)
+    grid = NavGrid(origin_xy=(0.0, 0.0), resolution_m=1.0, free=corner, closed_doors=frozenset(), door_cells={})
+    assert reaches(grid, (1.5, 1.5), [(2.5, 2.5)]) and shortest_path(grid, (1.5, 1.5), [(2.5, 2.5)]).found
+    assert not reaches(grid, (1.5, 1.5), [(0.5, 0.5), (9.0, 9.0)])  # a blocked goal, one off the grid
+    open_grid = NavGrid(origin_xy=(0.0, 0.0), resolution_m=1.0, free=np.ones((3, 3), dtype=bool), closed_doors=frozenset(),
+                        door_cells={})
+    assert not reaches(open_grid, (1.5, 1.5), [(9.0, 9.0)])  # off the grid, though the nearest cell is free
 
 
 def test_grid_cached_per_door_state():
