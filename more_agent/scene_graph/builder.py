@@ -132,11 +132,7 @@ class SceneGraphBuilder:
                 self._lift(iid)  # the leaf swung: what was seen of it no longer blocks, but the door is still
                 if iid in self._boxes:  # there, in the state the robot knows, until seen again
                     self._remembered.add(iid)
-            if previous is None or (info.label, info.rests, info.held) != (
-                previous.label,
-                previous.rests,
-                previous.held,
-            ):
+            if previous is None or _carry_facts(info) != _carry_facts(previous):
                 self._carried_current = False
             self._instances[iid] = info
             (self._held.add if info.held else self._held.discard)(iid)
@@ -552,6 +548,11 @@ class SceneGraphBuilder:
             open=info.open,
             held=info.held,
         )
+
+
+def _carry_facts(info: InstanceInfo) -> tuple[str, tuple[str, str | None] | None, bool]:
+    """What ``SceneGraphBuilder._pick_up_contents`` reads of an instance: its label, what it rests on, whether held."""
+    return info.label, info.rests, info.held
 
 
 def _patch_at(patches: np.ndarray, grid: Grid, points: np.ndarray) -> np.ndarray:
