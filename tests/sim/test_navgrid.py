@@ -17,48 +17,20 @@ def two_room_scene(door_open: bool = True, door_width: float = 0.9) -> Scene:
     """Kitchen (x 0..4.95) and living room (x 5.05..10), 4 m deep, joined by one door at (5, 2)."""
     half = door_width / 2
     return Scene(
-        name="two_rooms",
-        bounds=(-0.1, -0.1, 10.1, 4.1),
-        rooms=[
-            Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4.95, 4)),
-            Room(id="living_room_0", type="living_room", bounds=(5.05, 0, 10, 4)),
-        ],
-        walls=[
-            Wall(bounds=(-0.1, -0.1, 10.1, 0)),
-            Wall(bounds=(-0.1, 4, 10.1, 4.1)),
-            Wall(bounds=(-0.1, 0, 0, 4)),
-            Wall(bounds=(10, 0, 10.1, 4)),
-            Wall(bounds=(4.95, 0, 5.05, 2 - half)),
-            Wall(bounds=(4.95, 2 + half, 5.05, 4)),
-        ],
-        doors=[
-            Door(
-                id="door_0",
-                rooms=("kitchen_0", "living_room_0"),
-                center=(5, 2),
-                width=door_width,
-                axis="y",
-                open=door_open,
-            )
-        ],
+        name="two_rooms", bounds=(-0.1, -0.1, 10.1, 4.1),
+        rooms=[Room(id="kitchen_0", type="kitchen", bounds=(0, 0, 4.95, 4)),
+               Room(id="living_room_0", type="living_room", bounds=(5.05, 0, 10, 4))],
+        walls=[Wall(bounds=(-0.1, -0.1, 10.1, 0)), Wall(bounds=(-0.1, 4, 10.1, 4.1)),
+               Wall(bounds=(-0.1, 0, 0, 4)), Wall(bounds=(10, 0, 10.1, 4)),
+               Wall(bounds=(4.95, 0, 5.05, 2 - half)), Wall(bounds=(4.95, 2 + half, 5.05, 4))],
+        doors=[Door(id="door_0", rooms=("kitchen_0", "living_room_0"), center=(5, 2), width=door_width, axis="y",
+                    open=door_open)],
         furniture=[
-            Furniture(
-                id="fridge_0",
-                category="fridge",
-                room="kitchen_0",
-                center=(0.45, 3.5, 0.9),
-                size=(0.8, 0.8, 1.8),
-                openable=True,
-            ),
+            Furniture(id="fridge_0", category="fridge", room="kitchen_0", center=(0.45, 3.5, 0.9), size=(0.8, 0.8, 1.8),
+                      openable=True),
             Furniture(id="table_0", category="table", room="living_room_0", center=(7.5, 2, 0.4), size=(1.5, 0.9, 0.8)),
-            Furniture(
-                id="cabinet_0",
-                category="bottom_cabinet",
-                room="living_room_0",
-                center=(9.6, 0.4, 0.45),
-                size=(0.7, 0.7, 0.9),
-                openable=True,
-            ),
+            Furniture(id="cabinet_0", category="bottom_cabinet", room="living_room_0", center=(9.6, 0.4, 0.45),
+                      size=(0.7, 0.7, 0.9), openable=True),
         ],
     )
 
@@ -85,11 +57,11 @@ def labelled(world: World) -> InstanceLabels:
 def test_free_space_excludes_walls_furniture_and_keeps_clearance():
     grid = nav_grid(two_room_world())
     assert grid.is_free(2.5, 1.0)
-    assert not grid.is_free(5.0, 1.0)  # wall
-    assert not grid.is_free(7.5, 2.0)  # table
-    assert not grid.is_free(7.5, 2.45 + 0.1)  # within the robot radius of the table
+    assert not grid.is_free(5.0, 1.0)          # wall
+    assert not grid.is_free(7.5, 2.0)          # table
+    assert not grid.is_free(7.5, 2.45 + 0.1)   # within the robot radius of the table
     assert grid.is_free(7.5, 2.45 + 0.35)
-    assert not grid.is_free(20.0, 2.0)  # outside the scene
+    assert not grid.is_free(20.0, 2.0)         # outside the scene
 
 
 def test_a_footprint_thinner_than_a_cell_blocks_the_grid_as_it_blocks_the_base():
@@ -101,13 +73,8 @@ def test_a_footprint_thinner_than_a_cell_blocks_the_grid_as_it_blocks_the_base()
     x0, x1 = centre + 0.3 * res, centre + 0.6 * res  # between that column and the next
     scene = two_room_scene()
     scene.furniture.append(
-        Furniture(
-            id="room_divider_0",
-            category="room_divider",
-            room="living_room_0",
-            center=((x0 + x1) / 2, 2.0, 0.9),
-            size=(x1 - x0, 4.0, 1.8),
-        )
+        Furniture(id="room_divider_0", category="room_divider", room="living_room_0",
+                  center=((x0 + x1) / 2, 2.0, 0.9), size=(x1 - x0, 4.0, 1.8))
     )
     world = World.from_scene(scene)
     world.set_robot_pose(2.5, 1.0, 0.0)
