@@ -8,7 +8,7 @@ files). A world built by other code is never read; rows of another fingerprint a
 write. Instances are pickled into one sqlite file that parallel workers share (a busy timeout; each
 process opens its own connection).
 
-Building a world is about a tenth of a grounded episode and most of an oracle one (docs/benchmarks.md);
+Building a world is about a twentieth of a grounded episode and a third of an oracle one (docs/benchmarks.md);
 a sweep of seven planners over 165 worlds builds each once. ``MORE_AGENT_WORLD_CACHE`` names the file
 (default ``~/.cache/more-agent/worlds.sqlite``), or ``off``. The cache never costs an episode: a file it
 cannot read or write, or a row it cannot load, is logged and the world is built as without it.
