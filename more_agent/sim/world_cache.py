@@ -24,7 +24,7 @@ import pickle
 import sqlite3
 import sys
 from contextlib import closing
-from functools import cache
+from functools import cache, partial
 from importlib.metadata import version
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -83,18 +83,18 @@ def instantiate_cached(
     holds it and writing it there when not. Bad input raises as ``instantiate`` does (nothing is cached)."""
     from more_agent.sim.instantiate import instantiate
 
+    build = partial(instantiate, task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
     path = world_cache_path()
     if path is None:
-        return instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+        return build()
     try:
-        key = instance_key(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
+        key = instance_key(*build.args, **build.keywords)
     except OSError:  # an unreadable scene file: instantiate says what is wrong with it
-        return instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
-    cached = _read(path, key)
-    if cached is not None:
-        return cached
-    instance = instantiate(task, scene, seed, start=start, distractors=distractors, descriptions=descriptions)
-    _write(path, key, instance)
+        return build()
+    instance = _read(path, key)
+    if instance is None:
+        instance = build()
+        _write(path, key, instance)
     return instance
 
 

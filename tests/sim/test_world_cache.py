@@ -116,7 +116,7 @@ def test_off_builds_every_world_and_writes_nothing(
     tmp_path: Path, builds: list, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv(ENV_WORLD_CACHE, "off")
-    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.setattr(world_cache, "DEFAULT_WORLD_CACHE", tmp_path / "default.sqlite")  # where it would write
     instantiate_cached(TASK, str(KITCHEN), 0)
     instantiate_cached(TASK, str(KITCHEN), 0)
     assert len(builds) == 2 and world_cache_path() is None and not list(tmp_path.rglob("*.sqlite"))
