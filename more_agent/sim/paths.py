@@ -63,11 +63,17 @@ class NavGrid(Grid):
         return ok
 
     @cached_property
-    def _mcp(self) -> MCP_Geometric:
-        """The path search over this raster (y-major, see the module docstring), built once: its cost
-        array costs as much to set up as a search (5 ms on a house's grid), and a magic action searches one
-        world grid many times. ``find_costs`` starts afresh on each call."""
-        return MCP_Geometric(np.where(self.free.T, 1.0, np.inf))
+    def _mcp(self) -> tuple[MCP_Geometric, np.ndarray]:
+        """The path search over this raster (y-major, see the module docstring), built once, and the (ix, iy)
+        of its first cell. It covers only the free cells' bounding box, with a rim of blocked cells: a search
+        never enters a blocked cell, so it pushes and pops the same cells in the same order as one over the
+        whole raster and finds the same path, while setting up its arrays costs as much as a search (12 ms on a
+        store's map, of which the free box is a third). Built once, as a magic action searches one world grid
+        many times; ``find_costs`` starts afresh on each call."""
+        rows, cols = np.flatnonzero(self.free.any(axis=1)), np.flatnonzero(self.free.any(axis=0))  # one at least
+        lo = np.array([max(rows[0] - 1, 0), max(cols[0] - 1, 0)])
+        box = self.free[lo[0] : rows[-1] + 2, lo[1] : cols[-1] + 2]
+        return MCP_Geometric(np.where(box.T, 1.0, np.inf)), lo
 
     @cached_property
     def _components(self) -> np.ndarray:
@@ -180,14 +186,14 @@ def shortest_path(grid: NavGrid, start: XY, goals: Sequence[XY]) -> PathResult:
     goal_cells = [grid.cell_at(*goals[i]) for i in goal_index]
     if start_cell is None or not goal_cells:
         return _NO_PATH
-    mcp = grid._mcp
-    goals_yx = [cell[::-1] for cell in goal_cells]
-    cum, _ = mcp.find_costs([start_cell[::-1]], goals_yx, find_all_ends=False)
+    mcp, (x0, y0) = grid._mcp
+    goals_yx = [(iy - y0, ix - x0) for ix, iy in goal_cells]
+    cum, _ = mcp.find_costs([(start_cell[1] - y0, start_cell[0] - x0)], goals_yx, find_all_ends=False)
     reached = [(float(cum[yx]), i) for i, yx in enumerate(goals_yx) if np.isfinite(cum[yx])]
     if not reached:
         return _NO_PATH
     cost, k = min(reached)
-    path_yx = np.asarray(mcp.traceback(goals_yx[k]))
+    path_yx = np.asarray(mcp.traceback(goals_yx[k])) + (y0, x0)
     cells = [(int(ix), int(iy)) for iy, ix in path_yx]
     simplified = simplify_polyline(path_yx.astype(float), tolerance=1.0)
     waypoints = [(float(start[0]), float(start[1]))]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from skimage.graph import MCP_Geometric
 
 from more_agent.sim.labels import InstanceLabels
 from more_agent.sim.navgrid import NavConfig, blocking_door, free_cells, nav_grid, reachable, shortest_path
@@ -143,6 +144,34 @@ def test_reaches_says_what_the_search_finds_without_searching():
     open_grid = NavGrid(origin_xy=(0.0, 0.0), resolution_m=1.0, free=np.ones((3, 3), dtype=bool), closed_doors=frozenset(),
                         door_cells={})
     assert not reaches(open_grid, (1.5, 1.5), [(9.0, 9.0)])  # off the grid, though the nearest cell is free
+
+
+def test_the_search_over_the_free_cells_box_finds_the_whole_raster_s_path():
+    """``NavGrid._mcp`` searches only the bounding box of the free cells: on random rasters whose free cells
+    lie anywhere (touching the raster's edge or far from it), each path is the one a search over the whole
+    raster traces, cell for cell, at the same cost."""
+    rng = np.random.default_rng(11)
+    for trial in range(80):
+        nx, ny = int(rng.integers(4, 30)), int(rng.integers(4, 30))
+        free = np.zeros((nx, ny), dtype=bool)
+        x0, y0 = int(rng.integers(0, nx - 2)), int(rng.integers(0, ny - 2))
+        x1, y1 = int(rng.integers(x0 + 2, nx + 1)), int(rng.integers(y0 + 2, ny + 1))
+        free[x0:x1, y0:y1] = rng.random((x1 - x0, y1 - y0)) < 0.7
+        cells = np.argwhere(free)
+        if len(cells) < 2:
+            continue
+        grid = NavGrid(origin_xy=(0.0, 0.0), resolution_m=1.0, free=free, closed_doors=frozenset(), door_cells={})
+        whole = MCP_Geometric(np.where(free.T, 1.0, np.inf))
+        for _ in range(5):
+            start, *goals = cells[rng.choice(len(cells), size=int(rng.integers(2, 5)))]
+            path = shortest_path(grid, tuple(start + 0.5), [tuple(g + 0.5) for g in goals])
+            cum, _ = whole.find_costs([start[::-1]], [g[::-1] for g in goals], find_all_ends=False)
+            reached = [(cum[g[1], g[0]], i) for i, g in enumerate(goals) if np.isfinite(cum[g[1], g[0]])]
+            assert path.found == bool(reached), trial
+            if reached:
+                cost, k = min(reached)
+                assert path.goal_index == k and path.length_m == cost, trial
+                assert path.cells == [(int(ix), int(iy)) for iy, ix in whole.traceback(tuple(goals[k][::-1]))], trial
 
 
 def test_grid_cached_per_door_state():
