@@ -134,7 +134,8 @@ class Grid:
         points = np.asarray(path, dtype=float).reshape(-1, 2)
         steps = np.diff(points, axis=0)
         counts = np.ceil(np.abs(steps).max(axis=1) / self.resolution_m).astype(int)
-        between = [
-            points[i] + steps[i] * (np.arange(1, counts[i])[:, None] / counts[i]) for i in np.flatnonzero(counts > 1)
-        ]
-        return np.concatenate([points, *between]) if between else points
+        inner = np.maximum(counts - 1, 0)  # points strictly between a segment's ends
+        segment = np.repeat(np.arange(len(steps)), inner)
+        k = np.arange(len(segment)) - np.repeat(np.cumsum(inner) - inner, inner) + 1  # 1, 2, ... within a segment
+        between = points[segment] + steps[segment] * (k / counts[segment])[:, None]
+        return np.concatenate([points, between])
