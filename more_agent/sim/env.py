@@ -428,6 +428,8 @@ class SimRobot:
         self._on_frame, self._on_sensed = on_frame, on_sensed
         self._held: str | None = None
         """The held item at the last sensing (to report one released since)."""
+        self._infos: dict[tuple[object, ...], InstanceInfo] = {}
+        """Each distinct report of an instance, once (``_info``)."""
         self._steps = 0
         self._trajectory: list[XY] = [self.pose[:2]]
         self._reported_steps, self._reported_path = 0, 1
@@ -477,9 +479,7 @@ class SimRobot:
             self._on_frame(frame)
         table = self._labels.table(world, frame.instance)
         infos = {
-            i: InstanceInfo(
-                label=d["label"], category=d["category"], open=d["open"], held=d["held"], rests=self._rests(d["name"])
-            )
+            i: self._info(d["label"], d["category"], d["open"], d["held"], self._rests(d["name"]))
             for i, d in table.items()
         }
         released = self._held if self._held is not None and self._held != world.robot.held else None
@@ -487,16 +487,14 @@ class SimRobot:
         inner = [obj for name in acted for obj in world.shown_by_opening(name)]
         self._labels.observe(inner)
         for obj in [*map(world.get, acted), *([world.get(released)] if released is not None else []), *inner]:
-            infos.setdefault(
-                obj.instance_id,
-                InstanceInfo(
-                    label=self._labels.label(obj.name),
-                    category=obj.category,
-                    open=obj.is_open if obj.openable else None,
-                    held=world.robot.held == obj.name,
-                    rests=self._rests(obj.name),
-                ),
-            )
+            if obj.instance_id not in infos:
+                infos[obj.instance_id] = self._info(
+                    self._labels.label(obj.name),
+                    obj.category,
+                    obj.is_open if obj.openable else None,
+                    world.robot.held == obj.name,
+                    self._rests(obj.name),
+                )
         placed = {}
         if released is not None:  # with what rode on it
             placed = {obj.instance_id: obj.box() for obj in [world.get(released), *world.descendants(released)]}
@@ -508,6 +506,17 @@ class SimRobot:
         if self._on_sensed is not None:
             self._on_sensed(seen)
         return seen
+
+    def _info(
+        self, label: str, category: str, open: bool | None, held: bool, rests: tuple[Relation, str | None] | None
+    ) -> InstanceInfo:
+        """What perception says of an instance, as one frozen model per distinct report: most instances in view
+        are reported alike frame after frame, and a frame shows dozens."""
+        key = (label, category, open, held, rests)
+        info = self._infos.get(key)
+        if info is None:
+            info = self._infos[key] = InstanceInfo(label=label, category=category, open=open, held=held, rests=rests)
+        return info
 
     def _rests(self, name: str) -> tuple[Relation, str | None] | None:
         """How a seen object rests, as perception reports it: the world's support link (what the last
