@@ -175,18 +175,19 @@ def assign_objects(
     kk = min(k, cand.size)
     adjacency = graph.csr(None if cut is None else ~cut)
     objects_xy, viewpoints_xy = np.asarray(objects_xy, float), np.asarray(viewpoints_xy, float)
-    near_o = _near_nodes(objects_xy, tree, cand, kk, graph, blocked, grid, radius_m)
-    near_vp = _near_nodes(viewpoints_xy, tree, cand, kk, graph, blocked, grid, radius_m)
-    for j, ((s_o, d_o), (s_vp, d_vp)) in enumerate(zip(near_o, near_vp)):
-        common = sorted(set(labels[s_o].tolist()) & set(labels[s_vp].tolist()))
-        if not common:
-            out[j] = labels[s_o[0]]
-        elif len(common) == 1:
-            out[j] = common[0]
-        else:
-            dv = csgraph.dijkstra(adjacency, directed=False, indices=s_vp)[:, s_o]  # (|S_vp|, |S_O|)
-            cost = dv + d_o[None, :] ** lam + d_vp[:, None]
-            out[j] = labels[s_o[np.unravel_index(np.argmin(cost), cost.shape)[1]]]
+    nodes_o, d_o, near_o = _near_nodes(objects_xy, tree, cand, kk, graph, blocked, grid, radius_m)
+    nodes_vp, d_vp, near_vp = _near_nodes(viewpoints_xy, tree, cand, kk, graph, blocked, grid, radius_m)
+    lab_o, lab_vp = labels[nodes_o], labels[nodes_vp]  # every candidate node has a region (>= 0)
+    shared = (lab_o[:, :, None] == lab_vp[:, None, :]) & near_o[:, :, None] & near_vp[:, None, :]
+    common = np.sort(np.where(shared.any(axis=2), lab_o, -1), axis=1)  # the regions S_O and S_vp share, -1 pads
+    n_common = (common[:, :1] >= 0).sum(axis=1) + ((common[:, 1:] != common[:, :-1]) & (common[:, 1:] >= 0)).sum(axis=1)
+    rows = np.arange(len(objects_xy))
+    out[:] = np.where(n_common == 0, lab_o[rows, np.argmax(near_o, axis=1)], common[:, -1])  # none: the closest
+    for j in np.flatnonzero(n_common > 1).tolist():
+        s_o, s_vp = nodes_o[j, near_o[j]], nodes_vp[j, near_vp[j]]
+        dv = csgraph.dijkstra(adjacency, directed=False, indices=s_vp)[:, s_o]  # (|S_vp|, |S_O|)
+        cost = dv + d_o[j, near_o[j]][None, :] ** lam + d_vp[j, near_vp[j]][:, None]
+        out[j] = labels[s_o[np.unravel_index(np.argmin(cost), cost.shape)[1]]]
     return out
 
 
@@ -199,9 +200,9 @@ def _near_nodes(
     blocked: np.ndarray | None,
     grid: Grid | None,
     radius_m: float,
-) -> list[tuple[np.ndarray, np.ndarray]]:
-    """S_p of Eq. 1 for each point: its ``kk`` nearest candidate nodes, those it sees if it sees any,
-    within ``radius_m`` (or the closest); as (node indices, distances), nearest first."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """S_p of Eq. 1 for each point: its ``kk`` nearest candidate nodes, those it sees if it sees any, within
+    ``radius_m`` (or the closest); as (node indices, distances, whether near), each (n, kk), nearest first."""
     d, i = tree.query(points, k=kk)
     d, i = d.reshape(len(points), kk), i.reshape(len(points), kk)
     keep = np.ones(d.shape, dtype=bool)
@@ -210,4 +211,4 @@ def _near_nodes(
         keep = seen | ~seen.any(axis=1, keepdims=True)
     first = np.take_along_axis(d, np.argmax(keep, axis=1)[:, None], axis=1)
     keep &= d <= np.maximum(radius_m, first)
-    return [(cand[i[j, keep[j]]], d[j, keep[j]]) for j in range(len(points))]
+    return cand[i], d, keep

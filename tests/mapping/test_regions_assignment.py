@@ -6,6 +6,7 @@ import pytest
 from more_agent.mapping import (
     Grid,
     MappingConfig,
+    NavGraph,
     assign_objects,
     door_crossing_edges,
     doorway_mask,
@@ -91,6 +92,18 @@ def test_object_goes_to_its_room_not_the_one_behind_the_wall() -> None:
     assert got_b[0] == label_a
     with pytest.raises(ValueError, match="grid"):  # a blocked mask means nothing without its placement
         assign_objects(g, labels, obj, vp, cut=cut, blocked=occ == OCCUPIED)
+
+
+def test_an_object_sharing_no_region_with_its_viewpoint_goes_to_the_nearest_node_it_sees() -> None:
+    """With no region common to S_O and S_vp, the object goes to the region of its closest node in S_O: the
+    closest it sees, not the closest of all, which lies behind the wall."""
+    blocked = np.zeros((8, 8), dtype=bool)
+    blocked[4, :] = True  # a wall at 2.0 <= x < 2.5
+    xy = np.array([[2.75, 1.25], [0.5, 1.25], [0.75, 3.75]])  # behind the wall (region 1), beside (0), far (2)
+    g = NavGraph(xy, np.zeros((0, 2), dtype=np.int64), np.zeros(0))
+    obj, vp = np.array([[1.75, 1.25]]), np.array([[2.75, 2.25]])  # the viewpoint sees only the node behind the wall
+    got = assign_objects(g, np.array([1, 0, 2]), obj, vp, blocked=blocked, grid=Grid(resolution_m=0.5), radius_m=1.3)
+    assert got.tolist() == [0]
 
 
 def test_object_seen_through_a_window_goes_to_the_indoor_region() -> None:
