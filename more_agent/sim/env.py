@@ -508,14 +508,14 @@ class SimRobot:
         return seen
 
     def _info(
-        self, label: str, category: str, open: bool | None, held: bool, rests: tuple[Relation, str | None] | None
+        self, label: str, category: str, is_open: bool | None, held: bool, rests: tuple[Relation, str | None] | None
     ) -> InstanceInfo:
         """What perception says of an instance, as one frozen model per distinct report: most instances in view
         are reported alike frame after frame, and a frame shows dozens."""
-        key = (label, category, open, held, rests)
+        key = (label, category, is_open, held, rests)
         info = self._infos.get(key)
         if info is None:
-            info = self._infos[key] = InstanceInfo(label=label, category=category, open=open, held=held, rests=rests)
+            info = self._infos[key] = InstanceInfo(label=label, category=category, open=is_open, held=held, rests=rests)
         return info
 
     def _rests(self, name: str) -> tuple[Relation, str | None] | None:

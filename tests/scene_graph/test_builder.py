@@ -248,6 +248,28 @@ def test_the_graph_follows_the_frames_not_how_often_it_was_built() -> None:
     assert once.model_dump(exclude={"step"}) == live.model_dump(exclude={"step"})  # but the count of builds
 
 
+def test_a_graph_built_after_every_turn_holds_the_objects_one_build_at_the_end_holds() -> None:
+    """Built after each turn in place (the live robot), the graph must put every object in the same region,
+    with the same box and state, as one build after the same frames (a bag's ingest): nodes the builder keeps
+    from one build to the next must follow what changed. Region ids follow the builds, so the regions are
+    compared as the sets of objects they hold."""
+    boxes, infos = two_rooms()
+    live = new_builder()
+    for xy in ROOMS:
+        explore(live, boxes, infos, [xy], n_yaw=6)
+        live.build(xy)
+    once = new_builder()
+    explore(once, boxes, infos, ROOMS, n_yaw=6)
+    graphs = [b.build(ROOMS[-1]) for b in (live, once)]
+
+    def holdings(g: SceneGraph) -> set[frozenset[str]]:
+        return {frozenset(o.id for o in g.objects_in(rid)) for rid in g.regions}
+
+    assert holdings(graphs[0]) == holdings(graphs[1]) and len(holdings(graphs[1])) > 1
+    nodes = [{o.id: o.model_dump(exclude={"region_id"}) for o in g.objects.values()} for g in graphs]
+    assert nodes[0] == nodes[1]
+
+
 def _rooms_behind_a_slit() -> tuple[list[Box], dict[int, InstanceInfo]]:
     """Two rooms (x in [0, 4] and [4.15, 8.15]) joined by a doorway (y 1.9..2.1) narrower on the map
     than the graph's clearance, with a table in each."""
