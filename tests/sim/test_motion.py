@@ -89,6 +89,13 @@ def test_furniture_and_walls_block_but_items_and_wall_cabinets_do_not():
     assert not any(np.allclose(b, (5.6, 0.6, 6.0, 1.4)) for b in boxes)
 
 
+def test_clearance_is_signed_and_infinite_without_boxes():
+    boxes = np.array([[0.0, 0.0, 1.0, 1.0], [3.0, 0.0, 4.0, 1.0]])
+    assert clearance(boxes, 0.5, 0.25) == pytest.approx(-0.25)  # inside: minus the distance to the nearest side
+    assert clearance(boxes, 2.0, 2.0) == pytest.approx(math.sqrt(2.0))  # to the nearer box's corner
+    assert clearance(np.zeros((0, 4)), 0.0, 0.0) == math.inf
+
+
 def test_overlapping_robot_may_back_out_but_not_push_in():
     world = corridor()
     world.set_robot_pose(0.75, 1.0, math.pi)  # disc overlaps the cabinet (face at x = 0.6)
