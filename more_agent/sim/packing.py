@@ -9,6 +9,7 @@ in the way, and rests the item where these functions say. Supports with inner sh
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -160,7 +161,15 @@ def _slots(lo: np.ndarray, hi: np.ndarray, half: np.ndarray, *, flush: bool) -> 
     """(n, 2) slot centres on a surface from ``lo`` to ``hi`` for an item of half extents ``half``: a
     grid from the near corner in reading order (rows follow y); with ``flush``, then the same grid
     mirrored to each other corner, whose slots lie flush with the far edges where the first grid
-    leaves a strip narrower than the item (a lamp in one corner of a nightstand leaves the far end)."""
+    leaves a strip narrower than the item (a lamp in one corner of a nightstand leaves the far end).
+    Read-only: a world's distractors ask for the same grids again and again (one size per category)."""
+    return _slot_grid(*(np.asarray(a, dtype=float).tobytes() for a in (lo, hi, half)), flush)
+
+
+@lru_cache(maxsize=4096)
+def _slot_grid(lo_bytes: bytes, hi_bytes: bytes, half_bytes: bytes, flush: bool) -> np.ndarray:
+    """``_slots`` of the float64 arrays these bytes hold."""
+    lo, hi, half = (np.frombuffer(b) for b in (lo_bytes, hi_bytes, half_bytes))
     xs, ys = (_slot_centres(lo[k], hi[k], half[k]) for k in (0, 1))
     grids = [(xs, ys)]
     if flush:
@@ -169,7 +178,9 @@ def _slots(lo: np.ndarray, hi: np.ndarray, half: np.ndarray, *, flush: bool) -> 
     out = []
     for gx, gy in (np.meshgrid(a, b) for a, b in grids):
         out.append(np.stack([gx.ravel(), gy.ravel()], axis=1))
-    return np.concatenate(out)
+    slots = np.concatenate(out)
+    slots.setflags(write=False)
+    return slots
 
 
 def _slot_centres(lo: float, hi: float, half: float) -> np.ndarray:
