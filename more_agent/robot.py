@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from functools import cached_property
 from typing import Generic, Protocol, TypeVar
 
 import numpy as np
@@ -63,6 +64,14 @@ class Frame:
     instance: np.ndarray
     K: np.ndarray
     T_world_cam: np.ndarray
+
+    @cached_property
+    def instance_pixels(self) -> np.ndarray:
+        """Pixels per instance id (``np.bincount`` of ``instance``; read-only), counted once: the simulator's
+        perception, the robot's bookkeeping and BUMBLE's memory each ask of every frame."""
+        pixels = np.bincount(self.instance.ravel())
+        pixels.setflags(write=False)
+        return pixels
 
 
 class InstanceInfo(BaseModel):

@@ -477,7 +477,7 @@ class SimRobot:
             frame = self._renderer.render_at(world, pose)
         if self._on_frame is not None:
             self._on_frame(frame)
-        table = self._labels.table(world, frame.instance)
+        table = self._labels.table(world, frame.instance, frame.instance_pixels)
         infos = {
             i: self._info(d["label"], d["category"], d["open"], d["held"], self._rests(d["name"]))
             for i, d in table.items()

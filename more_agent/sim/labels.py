@@ -73,8 +73,9 @@ class InstanceLabels:
         key = label.lower()
         return next((name for known, name in self._names.items() if known.lower() == key), None)
 
-    def table(self, world: World, instance: np.ndarray) -> dict[int, dict[str, Any]]:
-        """Metadata of every instance id seen in an instance image, plus the held item.
+    def table(self, world: World, instance: np.ndarray, pixels: np.ndarray | None = None) -> dict[int, dict[str, Any]]:
+        """Metadata of every instance id seen in an instance image, plus the held item. ``pixels``: the image's
+        pixels per id when the caller has counted them (``Frame.instance_pixels``).
 
         Objects seen for the first time get their label here, in the order of their first pixel, so
         labels follow the order of observation.
@@ -84,7 +85,7 @@ class InstanceLabels:
         old place.
         """
         flat = instance.ravel()
-        pixels = np.bincount(flat)  # per instance id
+        pixels = np.bincount(flat) if pixels is None else pixels  # per instance id
         seen = set(np.flatnonzero(pixels).tolist()) - {0}
         held = world.robot.held
         if held is not None:

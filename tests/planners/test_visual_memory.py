@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -55,6 +56,15 @@ def test_kept_frame_round_trips_its_images() -> None:
     assert np.array_equal(kept.rgb(), frame.rgb) and np.array_equal(kept.instance(), frame.instance)
     assert kept.pose == pytest.approx((1, 2, 0.3))
     assert kept.png.startswith(b"\x89PNG")
+
+
+def test_a_frame_counts_its_instance_pixels_once_and_a_replaced_frame_its_own() -> None:
+    """``Frame.instance_pixels`` is the image's bincount, read-only (several consumers share it); a frame made
+    from it with another instance image counts that image."""
+    frame = _frame(0, 0, 0, ids=(4, 9))
+    assert frame.instance_pixels is frame.instance_pixels and not frame.instance_pixels.flags.writeable
+    assert frame.instance_pixels.tolist() == np.bincount(frame.instance.ravel()).tolist()
+    assert np.flatnonzero(replace(frame, instance=np.full_like(frame.instance, 2)).instance_pixels).tolist() == [2]
 
 
 def test_points_seen_are_in_view_in_front_and_not_hidden() -> None:

@@ -145,7 +145,7 @@ class Embodiment:
         self.builder.integrate(
             frame.depth, frame.semantic, frame.instance, frame.K, frame.T_world_cam, seen.instances, self.xy
         )
-        self.observed.update([*np.flatnonzero(np.bincount(frame.instance.ravel())).tolist(), *seen.revealed])
+        self.observed.update([*np.flatnonzero(frame.instance_pixels).tolist(), *seen.revealed])
         if self.robot.held is not None:
             self.observed.add(self.robot.held)
         self.observed.discard(0)
