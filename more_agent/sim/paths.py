@@ -76,9 +76,9 @@ class NavGrid(Grid):
         return MCP_Geometric(np.where(box.T, 1.0, np.inf)), lo
 
     @cached_property
-    def _components(self) -> np.ndarray:
+    def components(self) -> np.ndarray:
         """The connected components of the free cells (0 elsewhere), with the eight neighbours the path search
-        steps to: two free cells are joined by a path exactly when they share a label."""
+        steps to: two free cells are joined by a path exactly when they share a label. Labelled once a grid."""
         return ndimage.label(self.free, structure=np.ones((3, 3), dtype=bool))[0]
 
     @cached_property
@@ -169,7 +169,7 @@ def reaches(grid: NavGrid, start: XY, goals: Sequence[XY]) -> bool:
     start_cell = grid.snap(*start)
     if start_cell is None:
         return False
-    components = grid._components
+    components = grid.components
     label = components[start_cell[0], start_cell[1]]
     cells = [grid.cell_at(*goals[i]) for i in np.flatnonzero(grid.free_at(goals)).tolist()]
     return any(components[ix, iy] == label for ix, iy in cells)

@@ -153,8 +153,7 @@ def reachable_part(grid: NavGrid, start: XY) -> NavGrid:
     cell = grid.snap(*start)
     if cell is None:
         return grid
-    components, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
-    return replace(grid, free=components == components[cell])
+    return replace(grid, free=grid.components == grid.components[cell])
 
 
 def path_to_nearest(

@@ -19,7 +19,6 @@ import math
 from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
-from scipy import ndimage
 
 from more_agent.mapping import FREE
 from more_agent.planners.policies.embodiment import Embodiment
@@ -121,7 +120,7 @@ def way_back(
     ``in_sight`` as in :func:`_drive`."""
     grid = _nav_grid(body, occupancy, retrace=True)
     sight = _sight(occupancy, in_sight)
-    parts, _ = ndimage.label(grid.free, structure=np.ones((3, 3), dtype=bool))
+    parts = grid.components
     here = grid.snap(*body.xy)
     tried = {parts[here] if here is not None else 0, 0}
     for way in _ways_back(body, RETRACE_M):
