@@ -50,16 +50,17 @@ def render(boxes: list[Box], K: np.ndarray, T: np.ndarray, size: int, max_range:
     tz = np.full(len(dirs), np.inf)
     best = np.zeros(len(dirs), dtype=np.intp)
     with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / dirs
+        inv = np.ascontiguousarray((1.0 / dirs).T)  # (3, pixels): each axis a row, so the slab joins rows
         for i, b in enumerate(boxes):
             pix = _pixels_of(b, K, T, size)
             if pix is not None and len(pix) == 0:
                 continue
-            lo, hi = np.subtract(b.lo, o), np.subtract(b.hi, o)
-            d = inv if pix is None else inv[pix]
+            lo, hi = np.subtract(b.lo, o)[:, None], np.subtract(b.hi, o)[:, None]
+            d = inv if pix is None else inv[:, pix]
             t1, t2 = lo * d, hi * d
-            tn = np.fmax.reduce(np.minimum(t1, t2), axis=1)  # fmax / fmin skip the NaN of 0 * inf, like nanmax
-            tf = np.fmin.reduce(np.maximum(t1, t2), axis=1)
+            near, far = np.minimum(t1, t2), np.maximum(t1, t2)
+            tn = np.fmax(np.fmax(near[0], near[1]), near[2])  # fmax / fmin skip the NaN of 0 * inf, like nanmax
+            tf = np.fmin(np.fmin(far[0], far[1]), far[2])
             t = np.where((tn <= tf) & (tf > 0), np.maximum(tn, 0), np.inf)
             idx = np.arange(len(dirs)) if pix is None else pix
             closer = t < tz[idx]
