@@ -158,7 +158,7 @@ class BagRecorder:
                 held=d["held"],
                 rests=_rests(world, labels, d["name"]),
             )
-            for iid, d in labels.table(world, frame.instance).items()
+            for iid, d in labels.table(world, frame.instance, frame.instance_pixels).items()
         }
         by_id = {o.instance_id: o for o in world.objects.values()}
         changed = [

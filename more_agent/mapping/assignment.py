@@ -180,7 +180,9 @@ def assign_objects(
     lab_o, lab_vp = labels[nodes_o], labels[nodes_vp]  # every candidate node has a region (>= 0)
     shared = (lab_o[:, :, None] == lab_vp[:, None, :]) & near_o[:, :, None] & near_vp[:, None, :]
     common = np.sort(np.where(shared.any(axis=2), lab_o, -1), axis=1)  # the regions S_O and S_vp share, -1 pads
-    n_common = (common[:, :1] >= 0).sum(axis=1) + ((common[:, 1:] != common[:, :-1]) & (common[:, 1:] >= 0)).sum(axis=1)
+    distinct = np.ones(common.shape, dtype=bool)
+    distinct[:, 1:] = common[:, 1:] != common[:, :-1]  # sorted: a region's first entry in its row
+    n_common = (distinct & (common >= 0)).sum(axis=1)
     rows = np.arange(len(objects_xy))
     out[:] = np.where(n_common == 0, lab_o[rows, np.argmax(near_o, axis=1)], common[:, -1])  # none: the closest
     for j in np.flatnonzero(n_common > 1).tolist():

@@ -358,7 +358,7 @@ class MoreAgentEnv(gym.Env[dict[str, np.ndarray], dict[str, Any]]):
             "intrinsics": frame.K,
             **state,
         }
-        return {"obs": obs, "instances": self.labels.table(self.world, frame.instance)}
+        return {"obs": obs, "instances": self.labels.table(self.world, frame.instance, frame.instance_pixels)}
 
     def _path_frames(self, path: list[tuple[float, float]]) -> list[dict[str, Any]]:
         """Views every ``path_frame_spacing_m`` along a path, facing along it (none when disabled)."""
