@@ -13,9 +13,9 @@ empty: no reader can beat chance on the others, docs/tasks.md); then one line pe
 the SR and TP gaps, overall and on those episodes. It reads the worlds only through the harness, so it
 runs unchanged on other worlds. Run:
 ``python benchmarks/pipeline_ceiling.py [--task-sets more-paper behavior-rearrange] [--seeds 3] [--first-seed 0] [--workers 2] [--limit N]
-[--start random|random-area|task-room] [--no-distractors] [--descriptions named paper] [--perception gt|noisy[:K=V,...]]``
-(run folders ``<out>/<start>[-no-distractors][/<perception>]/descriptions-<mode>/<task set>/<planner>``, the
-perception part only when not ``gt``; the oracle reads no description and runs in the first mode only). Each line also gives TTC and rTP, and the description modes of its records.
+[--start random|random-area|task-room] [--no-distractors] [--descriptions named paper] [--perception gt|noisy[:K=V,...]]
+[--sensing 1m/45deg]`` (run folders ``<out>/<start>[-no-distractors][/<perception>][/sensing-<cadence>]/descriptions-<mode>/<task set>/<planner>``,
+the perception part only when not ``gt``, the sensing part only when not the default; the oracle reads no description and runs in the first mode only). Each line also gives TTC and rTP, and the description modes of its records.
 """
 
 from __future__ import annotations
@@ -32,9 +32,10 @@ from more_agent.eval.harness import evaluate
 from more_agent.eval.metrics import MetricSummary, summarize
 from more_agent.eval.report import SourcedRecord
 from more_agent.eval.report_writer import write_reports
-from more_agent.eval.store import RunConfig, perception_part
+from more_agent.eval.store import RunConfig, perception_part, sensing_part
 from more_agent.perception_spec import GT, parse_perception
 from more_agent.records import EpisodeRecord
+from more_agent.sensing_spec import DEFAULT_SENSING, parse_sensing
 from more_agent.sim.descriptions import DESCRIPTION_MODES
 from more_agent.sim.tasks import task_set
 
@@ -87,15 +88,19 @@ def main() -> None:
     parser.add_argument("--descriptions", nargs="+", default=list(DESCRIPTION_MODES), choices=DESCRIPTION_MODES,
                         help="description modes (sim.descriptions); the oracle reads none, so it runs once")
     parser.add_argument("--perception", default=GT, help="'gt' or 'noisy[:KEY=VALUE,...]' (docs/sensors.md#noisy-perception)")
+    parser.add_argument("--sensing", default=DEFAULT_SENSING, help="'DISTANCEm/ANGLEdeg' (docs/sensors.md#sensing-cadence)")
     args = parser.parse_args()
     try:
         perception = parse_perception(args.perception).text()
+        sensing = parse_sensing(args.sensing).text()
     except UserError as e:
         parser.error(str(e))
 
     worlds = args.start if args.distractors else f"{args.start}-no-distractors"
     if perception != GT:
         worlds = f"{worlds}/{perception_part(perception)}"
+    if sensing != DEFAULT_SENSING:
+        worlds = f"{worlds}/{sensing_part(sensing)}"
     for name in args.task_sets:
         tasks = task_set(name)[: args.limit]
         for mode in args.descriptions:
@@ -106,7 +111,7 @@ def main() -> None:
                 config = RunConfig(
                     planner=planner, tasks=tasks, seeds=list(range(args.first_seed, args.first_seed + args.seeds)),
                     episode_fn="more_agent.eval.episode:run_episode", workers=args.workers, start=args.start,
-                    distractors=args.distractors, descriptions=run_mode, perception=perception,
+                    distractors=args.distractors, descriptions=run_mode, perception=perception, sensing=sensing,
                     more_agent_version=__version__,
                 )
                 run_dir = args.out / worlds / f"descriptions-{run_mode}" / name / planner

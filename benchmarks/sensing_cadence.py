@@ -37,9 +37,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from more_agent.eval.episode import run_episode  # noqa: E402
 from more_agent.eval.harness import resolve_tasks  # noqa: E402
 from more_agent.planners.policies.embodiment import Embodiment  # noqa: E402
-from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule  # noqa: E402
+from more_agent.planners.policies.sensing import SensingSchedule  # noqa: E402
 from more_agent.records import EpisodeSpec  # noqa: E402
 from more_agent.scene_graph import SceneGraph, SceneGraphBuilder  # noqa: E402
+from more_agent.sensing_spec import SensingCadence  # noqa: E402
 
 REFERENCE = SensingCadence(distance_m=0.3, angle_deg=1e-3)
 """A frame every 0.3 m (four full moves) and after every turn: the cadence before the schedule."""

@@ -19,9 +19,10 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from more_agent.errors import UserError
 from more_agent.perception_spec import parse_perception
+from more_agent.sensing_spec import DEFAULT_SENSING, LEGACY_SENSING, parse_sensing
 
-RECORD_SCHEMA_VERSION = 5
-"""5: ``perception`` (the perception mode), ``misperceived`` and ``perception_aliases``; 4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
+RECORD_SCHEMA_VERSION = 6
+"""6: ``sensing`` (the sensing cadence); 5: ``perception`` (the perception mode), ``misperceived`` and ``perception_aliases``; 4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
 only); 3: ``history`` (the action history option) and ``descriptions`` (the description mode). Older
 records are read through :data:`UPGRADES`."""
 
@@ -97,6 +98,14 @@ def canonical_perception(text: str) -> str:
         raise ValueError(str(e)) from None
 
 
+def canonical_sensing(text: str) -> str:
+    """The canonical text of a sensing cadence (``more_agent.sensing_spec``); ValueError when invalid."""
+    try:
+        return parse_sensing(text).text()
+    except UserError as e:
+        raise ValueError(str(e)) from None
+
+
 LEGACY_DESCRIPTIONS = "paper"
 """The description mode of the versions before the option: the paper's text (the instances its ``$``
 words name, nothing more)."""
@@ -135,7 +144,14 @@ def upgrade_from_4(data: dict[str, Any]) -> dict[str, Any]:
     return {"perception": GT_PERCEPTION, **data, "schema_version": 5}
 
 
-UPGRADES = {2: upgrade_from_2, 3: upgrade_from_3, 4: upgrade_from_4}
+def upgrade_from_5(data: dict[str, Any]) -> dict[str, Any]:
+    """A record of schema 5 in schema 6's form: its robot fused frames on the way at 0.5 m or 30 deg (the
+    cadence of those versions; the ones before f7db0a0 of 2026-12-01 fused a frame every 0.3 m and after every
+    turn)."""
+    return {"sensing": LEGACY_SENSING, **data, "schema_version": 6}
+
+
+UPGRADES = {2: upgrade_from_2, 3: upgrade_from_3, 4: upgrade_from_4, 5: upgrade_from_5}
 """Schema version -> the function that turns such a record into the next version's form. Schema 1
 predates the first release: no step exists, and validation refuses it (``record_validation``)."""
 
@@ -251,6 +267,10 @@ class EpisodeRecord(BaseModel):
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
     )
+    sensing: str = Field(
+        default=DEFAULT_SENSING,
+        description="Sensing cadence on the way, 'DISTANCEm/ANGLEdeg' (more_agent.sensing_spec).",
+    )
     long_term_memory: bool = Field(
         default=False,
         description="Whether the planner was given the failure summaries of earlier trials (BUMBLE's --add_past).",
@@ -331,7 +351,16 @@ class EpisodeRecord(BaseModel):
         )
 
 
-EPISODE_SETTINGS = ("llm", "start", "distractors", "descriptions", "history", "perception", "long_term_memory")
+EPISODE_SETTINGS = (
+    "llm",
+    "start",
+    "distractors",
+    "descriptions",
+    "history",
+    "perception",
+    "sensing",
+    "long_term_memory",
+)
 """The settings an episode shares with its run beside (task, scene, seed, planner): the one list that
 specs, records and folder names copy from each other, so a new setting is added here once."""
 
@@ -368,6 +397,11 @@ class EpisodeSpec(FrozenModel):
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode: 'gt' or 'noisy[:KEY=VALUE,...]' (more_agent.perception)."
     )
+    sensing: str = Field(
+        default=DEFAULT_SENSING,
+        description="Sensing cadence: the robot fuses a frame on the way once it moved DISTANCE or turned ANGLE "
+        "('DISTANCEm/ANGLEdeg', more_agent.sensing_spec).",
+    )
     long_term_memory: bool = Field(
         default=False, description="Give the planner the failure summaries of earlier trials (BUMBLE's --add_past)."
     )
@@ -381,3 +415,8 @@ class EpisodeSpec(FrozenModel):
     @classmethod
     def _canonical_perception(cls, value: str) -> str:
         return canonical_perception(value)
+
+    @field_validator("sensing")
+    @classmethod
+    def _canonical_sensing(cls, value: str) -> str:
+        return canonical_sensing(value)

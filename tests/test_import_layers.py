@@ -13,7 +13,7 @@ ROOT = Path(more_agent.__file__).parent
 
 LAYERS = (
     ("__init__", "errors", "redaction", "interrupts", "records", "record_validation", "safe_files", "skills",
-     "robot_spec", "vocabulary", "robot", "goal", "perception_spec"),
+     "robot_spec", "vocabulary", "robot", "goal", "perception_spec", "sensing_spec"),
     ("sim",),
     ("perception",),
     ("mapping",),

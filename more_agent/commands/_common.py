@@ -103,6 +103,16 @@ PerceptionOption = Annotated[
 ]
 """``--perception`` of ``run`` and ``eval``."""
 
+SensingOption = Annotated[
+    str,
+    typer.Option(
+        help="Sensing cadence: on the way, the robot's mapper fuses a frame once the base moved DISTANCE or turned "
+        "ANGLE since the last one, 'DISTANCEm/ANGLEdeg' (frames where it stops are always fused; 0.5m/30deg: "
+        "the cadence before this default; docs/sensors.md#sensing-cadence)."
+    ),
+]
+"""``--sensing`` of ``run`` and ``eval``."""
+
 
 RoomLLMOption = Annotated[
     str | None,

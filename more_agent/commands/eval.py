@@ -18,6 +18,7 @@ from more_agent.commands._common import (
     HistoryOption,
     PerceptionOption,
     RoomLLMOption,
+    SensingOption,
     StartOption,
     episodes_exit_status,
     err_console,
@@ -25,6 +26,7 @@ from more_agent.commands._common import (
     user_errors_exit_2,
 )
 from more_agent.errors import UserError
+from more_agent.sensing_spec import DEFAULT_SENSING
 
 RAY_ADDRESS = re.compile(r"local|auto|(ray://)?[A-Za-z0-9.\-\[\]:]+:\d{1,5}")
 """What ``--ray-address`` may be: 'local', 'auto', or HOST:PORT with an optional ray:// prefix."""
@@ -62,6 +64,7 @@ def eval_(
     descriptions: DescriptionsOption = "named",
     history: HistoryOption = "paper",
     perception: PerceptionOption = "gt",
+    sensing: SensingOption = DEFAULT_SENSING,
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
     ray_address: Annotated[
         str | None, typer.Option(help="Run on Ray: 'local', 'auto' or a cluster address (needs more-agent[ray]).")
@@ -100,6 +103,7 @@ def eval_(
     from more_agent.llm import parse_llm_spec
     from more_agent.llm.prompts import check_history
     from more_agent.perception_spec import parse_perception
+    from more_agent.sensing_spec import parse_sensing
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start_modes import check_start
     from more_agent.sim.tasks import check_scene_suits
@@ -121,6 +125,7 @@ def eval_(
     check_description_mode(descriptions)
     history_mode = check_history(history)
     perception_mode = parse_perception(perception).text()
+    sensing_cadence = parse_sensing(sensing).text()
     if episode_fn in (
         None,
         VIEWER_EPISODE_FN,
@@ -145,6 +150,7 @@ def eval_(
         descriptions=descriptions,
         history=history_mode,
         perception=perception_mode,
+        sensing=sensing_cadence,
         trials=trials,
         long_term_memory=long_term_memory,
         episode_fn=episode_fn or DEFAULT_EPISODE_FN,

@@ -26,6 +26,7 @@ from more_agent.commands._common import (
     HistoryOption,
     PerceptionOption,
     RoomLLMOption,
+    SensingOption,
     StartOption,
     console,
     episodes_exit_status,
@@ -34,6 +35,7 @@ from more_agent.commands._common import (
 )
 from more_agent.errors import UserError, check_writable_dir
 from more_agent.redaction import for_terminal
+from more_agent.sensing_spec import DEFAULT_SENSING
 
 if TYPE_CHECKING:
     from more_agent.interop.bag_writer import BagRecorder
@@ -130,6 +132,7 @@ def run(
     descriptions: DescriptionsOption = "named",
     history: HistoryOption = "paper",
     perception: PerceptionOption = "gt",
+    sensing: SensingOption = DEFAULT_SENSING,
     out: Annotated[
         Path | None, typer.Option(help="Output folder (default: runs/<task>-<scene>-<seed>-<planner>).")
     ] = None,
@@ -165,6 +168,7 @@ def run(
     from more_agent.planners.base import DEFAULT_PLANNER, default_planner, make_planner
     from more_agent.planners.bumble_memory import FailureStore
     from more_agent.records import EpisodeSpec
+    from more_agent.sensing_spec import parse_sensing
     from more_agent.sim.descriptions import check_description_mode
     from more_agent.sim.start_modes import check_start
     from more_agent.sim.tasks import check_scene_suits, load_task
@@ -176,6 +180,7 @@ def run(
     check_description_mode(descriptions)
     history_mode = check_history(history)
     perception_mode = parse_perception(perception).text()
+    sensing_cadence = parse_sensing(sensing).text()
     if scene is not None:
         check_scene_suits(task, scene)
     if planner is None:
@@ -196,6 +201,7 @@ def run(
         descriptions=descriptions,
         history=history_mode,
         perception=perception_mode,
+        sensing=sensing_cadence,
         long_term_memory=store is not None,
         past_failures=tuple(store.summaries(task)) if store is not None else (),
     )

@@ -35,6 +35,7 @@ from more_agent.records import DEFAULT_HISTORY, ActionRecord, EpisodeRecord, Epi
 from more_agent.redaction import redact
 from more_agent.robot import XY, Observation
 from more_agent.safe_files import DISK_FULL_ERRNOS
+from more_agent.sensing_spec import SensingCadence, parse_sensing
 
 if TYPE_CHECKING:
     from more_agent.interop.bag_writer import BagRecorder
@@ -165,6 +166,7 @@ def run_episode(
             trace_graphs=folder is not None and folder.graphs,
             perception=perception,
             past_failures=spec.past_failures,
+            sensing=parse_sensing(spec.sensing),
         )
         clock.add("sense", t)
         if folder is not None:
@@ -219,11 +221,13 @@ def reset_planner(
     trace_graphs: bool = False,
     perception: NoisyPerception | None = None,
     past_failures: tuple[str, ...] = (),
+    sensing: SensingCadence | None = None,
 ) -> tuple[SimRobot, PrivilegedContext | None]:
     """Start ``planner`` on ``instance``: build the robot it drives on the instance's world (``on_frame``
     gets every frame it renders, ``on_sensed`` every observation of one; with ``perception``, the planner
     drives it through a :class:`~more_agent.perception.robot.NoisyRobot`), tell it the task
-    (:func:`goal_spec`) and the ``past_failures`` of earlier trials, grant the world and the goal checker
+    (:func:`goal_spec`), the ``past_failures`` of earlier trials and the ``sensing`` cadence (default: the
+    default cadence), grant the world and the goal checker
     to a privileged planner (one with ``grant``: the oracle), then ``reset`` it. Returns the simulator's
     robot and the privileged context (None for any other planner)."""
     from more_agent.perception.robot import NoisyRobot
@@ -244,6 +248,7 @@ def reset_planner(
             llm=planner.llm,
             history=history,
             past_failures=past_failures,
+            sensing=sensing or SensingCadence(),
             trace_graphs=trace_graphs,
         )
     )

@@ -21,6 +21,7 @@ from more_agent.eval.metrics import METRIC_NAMES, MetricSummary, by_system, by_t
 from more_agent.eval.report import NO_VALUE, TABLE_I_CAVEATS, SourcedRecord, metric_cells
 from more_agent.eval.store import EPISODE_DIRS, episode_dir, episode_dirname
 from more_agent.records import EpisodeRecord
+from more_agent.sensing_spec import DEFAULT_SENSING
 
 THUMB_PX = 160
 """Width and height of episode thumbnails, in CSS pixels."""
@@ -37,10 +38,13 @@ img.plot{max-width:560px;max-height:420px;border:1px solid #ddd}pre{background:#
 
 def episode_file(record: EpisodeRecord, run_dir: Path, name: str) -> Path | None:
     """A file of the episode's folder under ``run_dir/episodes/``, looked up by resolved scene then 'auto'
-    (and in the folders of runs written before the LLM, start and distractors were part of the name)."""
+    (and in the folders of runs written before the LLM, start and distractors, or the sensing cadence, were
+    part of the name)."""
+    unnamed_cadence = record.model_copy(update={"sensing": DEFAULT_SENSING})
     for scene in (record.scene or None, None):
         for folder in (
             episode_dir(run_dir, record, scene or "auto"),
+            episode_dir(run_dir, unnamed_cadence, scene or "auto"),
             Path(run_dir) / EPISODE_DIRS / episode_dirname(record.task, scene, record.seed, record.planner),
         ):
             if (folder / name).is_file():

@@ -34,6 +34,7 @@ from more_agent.records import (
 )
 from more_agent.redaction import redact_tree
 from more_agent.safe_files import open_nofollow, read_bounded, write_atomic
+from more_agent.sensing_spec import DEFAULT_SENSING, LEGACY_SENSING
 
 EPISODES_FILE = "episodes.jsonl"
 RETRIED_FILE = "retried.jsonl"
@@ -65,6 +66,9 @@ class RunConfig(BaseModel):
     perception: str = Field(
         default=GT_PERCEPTION, description="Perception mode of every episode: 'gt' or 'noisy[:KEY=VALUE,...]'."
     )
+    sensing: str = Field(
+        default=DEFAULT_SENSING, description="Sensing cadence of every episode: 'DISTANCEm/ANGLEdeg' (--sensing)."
+    )
     trials: int = Field(default=1, ge=1, description="Trials of every (task, seed) world, run in sequence.")
     long_term_memory: bool = Field(
         default=False,
@@ -91,6 +95,7 @@ MIXING_FIELDS = (
     "descriptions",
     "history",
     "perception",
+    "sensing",
     "trials",
     "long_term_memory",
     "episode_fn",
@@ -112,12 +117,14 @@ def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunCo
     histories = sorted({r.history for r in records})
     descriptions = sorted({r.descriptions for r in records})
     perceptions = sorted({r.perception for r in records})
+    cadences = sorted({r.sensing for r in records})
     return config.model_copy(
         update={
             "start": starts[0] if len(starts) == 1 else ",".join(starts),
             "history": histories[0] if len(histories) == 1 else ",".join(histories),
             "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
             "perception": perceptions[0] if len(perceptions) == 1 else ";".join(perceptions),
+            "sensing": cadences[0] if len(cadences) == 1 else ",".join(cadences),
             "planner": planners[0] if len(planners) == 1 else ",".join(planners),
             "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
             "tasks": sorted({r.task for r in records} | set(config.tasks)),
@@ -282,7 +289,7 @@ def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[Epis
 
 def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> bool:
     """Whether ``record`` is an episode of ``spec``: same task, seed, planner, LLM, start, description mode,
-    history, perception, memory, distractors (a record that predates the distractors field matches either) and
+    history, perception, sensing cadence, memory, distractors (a record that predates the distractors field matches either) and
     scene (a record of a scene file's scene counts for the file); and, unless ``trial`` is False, the same trial."""
     if _match_key(record) != _match_key(spec) or (trial and record.trial != spec.trial):
         return False
@@ -293,7 +300,18 @@ def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> 
 
 def _match_key(x: EpisodeRecord | EpisodeSpec) -> tuple[object, ...]:
     """What a record shares with its spec beside scene, distractors and trial (:func:`of_spec`)."""
-    return (x.task, x.seed, x.planner, x.llm, x.start, x.descriptions, x.history, x.perception, x.long_term_memory)
+    return (
+        x.task,
+        x.seed,
+        x.planner,
+        x.llm,
+        x.start,
+        x.descriptions,
+        x.history,
+        x.perception,
+        x.sensing,
+        x.long_term_memory,
+    )
 
 
 def with_past_failures(spec: EpisodeSpec, records: list[EpisodeRecord]) -> EpisodeSpec | None:
@@ -335,13 +353,15 @@ def episode_dirname(
     descriptions: str = "named",
     history: str = "paper",
     perception: str = "gt",
+    sensing: str = DEFAULT_SENSING,
     long_term_memory: bool = False,
     trial: int = 0,
 ) -> str:
     """Directory name (under ``DIR/episodes/``) for one episode's files; 'auto' for an unset scene.
 
     The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
-    a history other than 'paper', a perception other than 'gt' and the long-term memory are part of the name,
+    a history other than 'paper', a perception other than 'gt', a sensing cadence other than the default and the
+    long-term memory are part of the name,
     so that the episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a
     folder; so is a trial other than the first (``t1`` is the second).
     """
@@ -358,6 +378,8 @@ def episode_dirname(
         parts.append(f"{history}-history")
     if perception != "gt":
         parts.append(perception_part(perception))
+    if sensing != DEFAULT_SENSING:
+        parts.append(sensing_part(sensing))
     if long_term_memory:
         parts.append("memory")
     return re.sub(r"[^A-Za-z0-9_.\-]", "_", "__".join(parts))
@@ -367,6 +389,11 @@ def perception_part(perception: str) -> str:
     """The perception mode's part of an episode folder name: the canonical text, hashed when long."""
     text = perception.replace(":", "-").replace("=", "").replace(",", "-")
     return text if len(text) <= 60 else f"noisy-{hashlib.sha256(perception.encode()).hexdigest()[:12]}"
+
+
+def sensing_part(sensing: str) -> str:
+    """The sensing cadence's part of a folder name: 'sensing-0.5m-30deg'."""
+    return f"sensing-{sensing.replace('/', '-')}"
 
 
 def episode_dir(run_dir: Path, episode: EpisodeSpec | EpisodeRecord, scene: str | None = None) -> Path:
@@ -389,7 +416,8 @@ def write_run_config(run_dir: Path, config: RunConfig) -> None:
 
 def read_run_config(run_dir: Path) -> RunConfig | None:
     """The run's configuration, or None if ``run.json`` is missing. A ``run.json`` written before the
-    history option gets the history its episodes ran with (:func:`~more_agent.records.legacy_history`)."""
+    history option gets the history its episodes ran with (:func:`~more_agent.records.legacy_history`), one
+    written before the sensing option the cadence of those versions."""
     path = Path(run_dir) / RUN_FILE
     if not path.exists():
         return None
@@ -399,6 +427,8 @@ def read_run_config(run_dir: Path) -> RunConfig | None:
             data = legacy_history(data)
         if isinstance(data, dict) and "descriptions" not in data:
             data = {**data, "descriptions": LEGACY_DESCRIPTIONS}
+        if isinstance(data, dict) and "sensing" not in data:
+            data = {**data, "sensing": LEGACY_SENSING}
         return RunConfig.model_validate(data)
     except (ValueError, ValidationError, RecursionError) as e:
         raise UserError(f"{path} is not a valid run configuration: {e}") from None

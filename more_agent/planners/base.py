@@ -24,6 +24,7 @@ from more_agent.errors import UserError, unknown_name_error
 from more_agent.goal import GoalSpec
 from more_agent.records import DEFAULT_HISTORY, HistoryMode, LLMUsage
 from more_agent.robot import Robot
+from more_agent.sensing_spec import SensingCadence
 
 if TYPE_CHECKING:
     from more_agent.planners.targets import Target
@@ -89,6 +90,8 @@ class EpisodeContext:
     """Which action history the LLM and VLM planners show (``more_agent.llm.prompts.history_text``)."""
     past_failures: tuple[str, ...] = ()
     """Long-term memory: failure summaries that earlier trials of the task left (BUMBLE's --add_past)."""
+    sensing: SensingCadence = field(default_factory=SensingCadence)
+    """How far the robot moves or turns between frames its mapper fuses on the way (``--sensing``)."""
     trace_graphs: bool = False
     """Whether each step's trace must carry the scene graph (``--save-graph``, ``--viewer``): a planner
     that does not plan on one builds it only then."""

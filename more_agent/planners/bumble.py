@@ -174,8 +174,11 @@ class BumblePlanner(MappingSession):
 
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
-        """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer)."""
-        self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping)
+        """Start an episode: fresh map, memory and history, then the full turn in place (its frames fill the buffer).
+        The robot senses on the way at least as often as the memory keeps frames: BUMBLE samples its camera
+        continuously, so a thinner ``--sensing`` cadence never starves its buffer."""
+        sensing = context.sensing.at_least_as_often_as(self.config.memory.keep)
+        self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping, sensing=sensing)
         self.memory = VisualMemory(self.config.memory)
 
         def on_frame(frame: Frame) -> None:

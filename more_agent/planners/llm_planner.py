@@ -170,7 +170,9 @@ class LLMPlanner(MappingSession):
     # -- Planner protocol ---------------------------------------------------------------------
     def reset(self, context: EpisodeContext) -> None:
         """Start an episode: a fresh map and history, then the full turn in place (paper S.3)."""
-        self.body = Embodiment(context.robot, config=self.config.policy, mapping=self.config.mapping)
+        self.body = Embodiment(
+            context.robot, config=self.config.policy, mapping=self.config.mapping, sensing=context.sensing
+        )
         described = context.goal.class_text if self.config.prompt == "moma" else ""
         self.task = described or context.goal.text
         self.history, self.history_mode, self.feedback = [], context.history, ""

@@ -139,7 +139,7 @@ class OraclePlanner:
         self._failures: Counter[tuple[str, tuple[str, ...]]] = Counter()
         self._last_failure: dict[tuple[str, tuple[str, ...]], ActionResult] = {}
         """Per action, its last failure: compared by typed reason and blocking door; its feedback explains a give-up."""
-        self._body = Embodiment(context.robot)
+        self._body = Embodiment(context.robot, sensing=context.sensing)
         self._trace_graphs = context.trace_graphs
         self._graph: SceneGraph | None = None
         """The step's scene graph, built only for the trace (the oracle plans from the world)."""

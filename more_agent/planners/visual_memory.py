@@ -2,10 +2,11 @@
 
 The paper's BUMBLE adaptation (supplementary "BUMBLE Implementation") samples frames continuously
 during execution so the VLM can pick a frame showing a previously seen object (landmark step) or an
-unexplored area (exploration). Here every rendered frame is offered to the buffer, which keeps it
-when the camera has moved or turned far enough since the last kept frame: the rule and default
-(0.5 m or 30 degrees) of the mapper's :class:`~more_agent.planners.policies.sensing.SensingCadence`
-(the initial full turn keeps every view: its turns are about 33 degrees).
+unexplored area (exploration). Here every frame the robot senses (at the episode's ``--sensing``
+cadence on the way) is offered to the buffer, which keeps it when the camera has moved or turned far
+enough since the last kept frame, by the rule of :class:`~more_agent.sensing_spec.SensingCadence` at
+0.5 m or 30 degrees (:data:`BUMBLE_KEEP`); the initial full turn keeps every view (its turns are about
+33 degrees).
 
 A kept frame holds its pose and its RGB, instance and coarse depth images compressed (about 12 kB
 per frame); the PNG a request sends is encoded the first time the frame is sent. Which objects a
@@ -25,9 +26,13 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.llm.images import png_bytes
-from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
+from more_agent.planners.policies.sensing import SensingSchedule
 from more_agent.robot import Frame
+from more_agent.sensing_spec import SensingCadence
 from more_agent.sim.camera import project
+
+BUMBLE_KEEP = SensingCadence(distance_m=0.5, angle_deg=30.0)
+"""The buffer's rule: a frame once the camera moved 0.5 m or turned 30 degrees since the last kept one."""
 
 DEPTH_STRIDE = 4
 """Kept depth images are subsampled by this factor per axis (64x64 for 256x256 frames)."""
@@ -39,7 +44,7 @@ class MemoryConfig(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     keep: SensingCadence = Field(
-        default_factory=SensingCadence,
+        default=BUMBLE_KEEP,
         description="Keep a frame once the camera moved or turned this far since the last kept one (the mapper's rule).",
     )
     max_images: int = Field(default=8, ge=1, description="Most buffer frames in one VLM request (subsampled beyond).")

@@ -20,6 +20,7 @@ from more_agent.planners.bumble import BUMBLE_CONFIGS, BumblePlanner
 from more_agent.planners.bumble_memory import HISTORY_IMAGES, RIGHT, WRONG
 from more_agent.planners.set_of_marks import annotate_marks
 from more_agent.records import EpisodeRecord, EpisodeSpec
+from more_agent.sensing_spec import SensingCadence
 from more_agent.skills import INVALID
 from tests.fakes.openai_server import request_images, request_text
 from tests.planners.brain import BrainServer
@@ -56,6 +57,13 @@ def test_explore_takes_the_room_its_chosen_frontiers_lie_in(solved: Any) -> None
     record = solved[0]
     explores = [a for a in record.actions if a.name == "explore"]
     assert explores and all(re.fullmatch(r"unknown_room_\d+", *a.arguments) for a in explores), explores
+
+
+def test_the_robot_senses_at_least_as_often_as_the_memory_keeps_frames(solved: Any) -> None:
+    """BUMBLE samples its camera continuously: the default 1m/45deg mapper cadence does not thin its buffer."""
+    record, planner = solved[0], solved[1]
+    assert record.sensing == "1m/45deg"
+    assert planner.body.schedule.cadence == planner.config.memory.keep == SensingCadence(distance_m=0.5, angle_deg=30)
 
 
 def test_scripted_vlm_completes_the_episode(solved: Any) -> None:

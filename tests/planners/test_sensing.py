@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from more_agent.planners.policies import Embodiment
-from more_agent.planners.policies.embodiment import PolicyConfig
-from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
+from more_agent.planners.policies.sensing import SensingSchedule
+from more_agent.sensing_spec import SensingCadence
 from more_agent.sim.env import SimRobot
 from more_agent.sim.instantiate import instantiate_in_scene
 from more_agent.sim.motion import clearance, obstacle_boxes
@@ -41,7 +41,7 @@ def test_frames_on_a_straight_drive_come_every_distance_and_at_arrival(distance_
     inst = instantiate_in_scene("putting_shopping_away", load_scene(KITCHEN), seed=0, start="task-room")
     robot = inst.world.robot
     inst.world.set_robot_pose(robot.x, robot.y, _clear_heading(inst.world, 1.5))
-    body = Embodiment(SimRobot(inst.world, labels=inst.labels), config=PolicyConfig(sensing=SensingCadence(distance_m=distance_m, angle_deg=30)))
+    body = Embodiment(SimRobot(inst.world, labels=inst.labels), sensing=SensingCadence(distance_m=distance_m, angle_deg=30))
     body.sense()  # the frame where the robot stands
     frames: list[tuple[float, float]] = []
     body.on_frame = lambda frame: frames.append(body.xy)

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from more_agent.llm.errors import InvalidAnswer
-from more_agent.planners.policies.sensing import SensingCadence
 from more_agent.planners.visual_memory import (
     MemoryConfig,
     VisualMemory,
@@ -19,6 +18,7 @@ from more_agent.planners.visual_memory import (
     spread,
 )
 from more_agent.planners.vlm_prompts import parse_choice, parse_step, parse_verdict
+from more_agent.sensing_spec import SensingCadence
 from more_agent.sim.camera import Camera
 from more_agent.sim.render import Frame
 
@@ -41,9 +41,9 @@ def test_buffer_keeps_a_frame_per_half_metre_or_thirty_degrees() -> None:
     assert [f.index for f in memory.frames] == [0, 1, 2] and memory.since(1) == memory.frames[1:]
 
 
-def test_buffer_keeps_frames_by_the_mappers_cadence() -> None:
-    """The buffer's rule is the embodiment's sensing cadence (``SensingCadence``), by default and when set."""
-    assert MemoryConfig().keep == SensingCadence()
+def test_buffer_keeps_frames_by_a_sensing_cadence() -> None:
+    """The buffer keeps frames by a ``SensingCadence``: BUMBLE's 0.5 m or 30 deg by default, or the one set."""
+    assert MemoryConfig().keep == SensingCadence(distance_m=0.5, angle_deg=30.0)
     memory = VisualMemory(MemoryConfig(keep=SensingCadence(distance_m=1.0, angle_deg=45.0)))
     poses = [(0, 0, 0), (0.6, 0, 0), (1.0, 0, 0), (1.0, 0, math.radians(40)), (1.0, 0, math.radians(46))]
     assert [memory.offer(_frame(*p)) is not None for p in poses] == [True, False, True, False, True]

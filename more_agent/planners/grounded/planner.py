@@ -42,7 +42,7 @@ class GroundedPlanner:
         self.agenda = agenda_of(context.goal.goal)
         self.belief = Belief()
         self.graph = None
-        self.body = Embodiment(context.robot, config=self.config)
+        self.body = Embodiment(context.robot, config=self.config, sensing=context.sensing)
         self.body.start()
 
     def observe(self) -> None:

@@ -5,9 +5,9 @@ Every low-level action (7.5 cm forward moves, turns of at most 35 degrees) and e
 one call of the robot (the simulator's steps its Gymnasium env), which counts it. Frames are sensed
 by the robot and fused into the :class:`~more_agent.scene_graph.SceneGraphBuilder` wherever the robot
 stops (arrival, a blocked move, after acting, every turn of a look around) and, on the way, at the
-cadence of its mapper (:class:`~more_agent.planners.policies.sensing.SensingSchedule`: once it moved
-or turned far enough since the last frame), so the map grows while the robot drives. Nothing here reads the world: what perception reports comes with each
-:class:`~more_agent.robot.Observation`.
+cadence of its mapper (the episode's ``sensing``, :class:`~more_agent.sensing_spec.SensingCadence`: once
+it moved or turned far enough since the last frame), so the map grows while the robot drives. Nothing
+here reads the world: what perception reports comes with each :class:`~more_agent.robot.Observation`.
 """
 
 from __future__ import annotations
@@ -20,10 +20,11 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from more_agent.mapping import MappingConfig
-from more_agent.planners.policies.sensing import SensingCadence, SensingSchedule
+from more_agent.planners.policies.sensing import SensingSchedule
 from more_agent.robot import XY, ActionResult, Frame, Robot
 from more_agent.robot_spec import FORWARD_STEP_M, MAX_TURN_RAD, ROBOT, full_turn_angles
 from more_agent.scene_graph import ObjectNode, SceneGraph, SceneGraphBuilder
+from more_agent.sensing_spec import SensingCadence
 
 PLAN_MARGIN_M = 0.05
 """Margin beyond the robot's radius that paths on the agent's map keep from mapped obstacles."""
@@ -48,9 +49,6 @@ class PolicyConfig(BaseModel):
         default=ROBOT.radius_m + PLAN_MARGIN_M,
         gt=0,
         description="Clearance from mapped obstacles kept by paths on the agent's map (robot radius + margin).",
-    )
-    sensing: SensingCadence = Field(
-        default_factory=SensingCadence, description="Distance or angle between frames fused on the way."
     )
     max_replans: int = Field(
         default=3, ge=0, description="Replans on the updated map after a blocked move before giving up."
@@ -92,6 +90,7 @@ class Embodiment:
         *,
         config: PolicyConfig | None = None,
         mapping: MappingConfig | None = None,
+        sensing: SensingCadence | None = None,
         on_frame: Callable[[Frame], None] | None = None,
     ) -> None:
         self.robot = robot
@@ -104,7 +103,7 @@ class Embodiment:
         """Called with every sensed frame (BUMBLE keeps them in its visual memory)."""
         self.observed: set[int] = set()
         """Instance ids seen so far, in view or in the hand (a planner tells from it whether a skill revealed anything)."""
-        self.schedule = SensingSchedule(self.config.sensing)
+        self.schedule = SensingSchedule(sensing)
         self.typed_on: dict[str, int] = {}
         """Region id -> how many object categories it showed when it was last typed (``RETYPE_GROWTH``)."""
 
