@@ -46,6 +46,23 @@ def test_tasks_show_json_names_the_instance() -> None:
     assert fridge["label"] == "fridge A"
 
 
+def test_tasks_show_reads_the_world_run_drives_from_the_world_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The instance is the one ``run`` with that seed builds: built once into the world cache, then read from it."""
+    monkeypatch.setenv("MORE_AGENT_WORLD_CACHE", str(tmp_path / "worlds.sqlite"))
+    first = _json(["tasks", "show", "putting_shopping_away", "--seed", "1"])
+    import more_agent.sim.instantiate as instantiate
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("built again instead of read from the world cache")
+
+    monkeypatch.setattr(instantiate, "instantiate", refuse)
+    assert _json(["tasks", "show", "putting_shopping_away", "--seed", "1"]) == first
+    text = runner.invoke(app, ["tasks", "show", "putting_shopping_away", "--seed", "1"])
+    assert text.exit_code == 0 and f"instantiated in {first['instance']['scene']} (seed 1; built in" in text.output
+
+
 def test_tasks_show_json_shows_a_goal_bddl_cannot_score() -> None:
     inst = _json(["tasks", "show", "make_a_bake_sale_stand_stall"])["instance"]  # no ground option for its goal
     assert inst["objects"] and inst["satisfiable"] is None

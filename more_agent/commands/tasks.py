@@ -134,12 +134,14 @@ def _print_definition(definition: TaskDefinition) -> None:
 
 def _print_instance(task: str, scene: str | None, seed: int) -> None:
     """The task instantiated: its scene, description, whether any state meets its goal, and where each
-    scope's object is."""
-    from more_agent.sim.instantiate import instantiate
+    scope's object is: the world ``run`` with that seed drives, read from the world cache when it holds it."""
+    from more_agent.sim.world_cache import instantiate_cached
 
-    inst = instantiate(task, scene, seed)
+    inst = instantiate_cached(task, scene, seed)
     console.print(
-        f"instantiated in {inst.scene} (seed {seed}) in {inst.timings['total']:.2f} s", highlight=False, markup=False
+        f"instantiated in {inst.scene} (seed {seed}; built in {inst.timings['total']:.2f} s)",
+        highlight=False,
+        markup=False,
     )
     console.print(f"description: {inst.description}", highlight=False, markup=False)
     if _satisfiable(inst) is False:
@@ -159,8 +161,7 @@ def _print_instance(task: str, scene: str | None, seed: int) -> None:
 
 
 def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
-    """What ``tasks show --json`` prints (keys in docs/cli-json.md)."""
-    from more_agent.sim.instantiate import instantiate
+    """What ``tasks show --json`` prints (keys in docs/cli-json.md); the instance as ``_print_instance`` reads it."""
     from more_agent.sim.tasks import (
         check_scene_suits,
         draw_scenes,
@@ -182,7 +183,9 @@ def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
         "instance": None,
     }
     if scenes or scene is not None:
-        inst = instantiate(task, scene, seed)
+        from more_agent.sim.world_cache import instantiate_cached
+
+        inst = instantiate_cached(task, scene, seed)
         objects = []
         for s, name in inst.scope.items():
             obj = inst.world.objects.get(name)
