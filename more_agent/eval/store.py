@@ -24,6 +24,7 @@ from more_agent.eval.runlock import LOCK_FILE
 from more_agent.record_validation import BadRecord, parse_record, record_json
 from more_agent.records import (
     DEFAULT_HISTORY,
+    EPISODE_SETTINGS,
     GT_PERCEPTION,
     LEGACY_DESCRIPTIONS,
     EpisodeRecord,
@@ -84,22 +85,7 @@ class RunConfig(BaseModel):
     )
 
 
-MIXING_FIELDS = (
-    "planner",
-    "llm",
-    "tasks",
-    "seeds",
-    "scene",
-    "start",
-    "distractors",
-    "descriptions",
-    "history",
-    "perception",
-    "sensing",
-    "trials",
-    "long_term_memory",
-    "episode_fn",
-)
+MIXING_FIELDS = ("planner", "tasks", "seeds", "scene", *EPISODE_SETTINGS, "trials", "episode_fn")
 """What a resumed run must share with the run already in its folder (unless mixing is allowed)."""
 
 
