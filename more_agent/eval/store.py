@@ -275,8 +275,9 @@ def pending(specs: list[EpisodeSpec], records: list[EpisodeRecord]) -> list[Epis
 
 def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> bool:
     """Whether ``record`` is an episode of ``spec``: same task, seed, planner, LLM, start, description mode,
-    history, perception, sensing cadence, memory, distractors (a record that predates the distractors field matches either) and
-    scene (a record of a scene file's scene counts for the file); and, unless ``trial`` is False, the same trial."""
+    history, perception, sensing cadence, memory, distractors (a record that predates the distractors field
+    matches either) and scene (a record of a scene file's scene counts for the file); and, unless ``trial`` is
+    False, the same trial."""
     if _match_key(record) != _match_key(spec) or (trial and record.trial != spec.trial):
         return False
     if record.distractors not in (None, spec.distractors):
@@ -347,8 +348,7 @@ def episode_dirname(
 
     The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
     a history other than 'paper', a perception other than 'gt', a sensing cadence other than the default and the
-    long-term memory are part of the name,
-    so that the episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a
+    long-term memory are part of the name, so that the episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a
     folder; so is a trial other than the first (``t1`` is the second).
     """
     parts = [task, scene or "auto", f"s{seed}" + (f"t{trial}" if trial else ""), planner]
