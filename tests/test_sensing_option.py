@@ -16,6 +16,7 @@ from more_agent.errors import UserError
 from more_agent.eval.episode import reset_planner
 from more_agent.eval.report_html import episode_file
 from more_agent.eval.store import RunConfig, check_same_run, episode_dirname, pending, read_run_config
+from more_agent.eval.worker import execute_episode
 from more_agent.planners.base import make_planner
 from more_agent.records import RECORD_SCHEMA_VERSION, EpisodeRecord, EpisodeSpec
 from more_agent.sensing_spec import DEFAULT_SENSING, SensingCadence, parse_sensing
@@ -73,6 +74,28 @@ def test_a_report_finds_the_files_of_an_episode_written_before_the_cadence_was_i
     folder.mkdir(parents=True)
     (folder / "map.png").write_bytes(b"png")
     assert episode_file(old, tmp_path, "map.png") == folder / "map.png"
+
+
+def test_an_episode_of_a_run_before_the_option_keeps_its_files_when_one_of_today_takes_its_folder(
+    tmp_path: Path,
+) -> None:
+    """--resume --allow-mixed on a run written before the cadence was in folder names: the new episode's folder is
+    the old one's name, and the old episode's files move to the folder today's layout names for it."""
+    old = EpisodeRecord.model_validate({"schema_version": 5, "task": "a", "scene": "s", "seed": 0, "planner": "more"})
+    folder = tmp_path / "episodes" / episode_dirname("a", None, 0, "more")  # the old layout, scene 'auto'
+    folder.mkdir(parents=True)
+    (folder / "episode.json").write_text(old.model_dump_json())
+    (folder / "map.png").write_bytes(b"old map")
+    spec = EpisodeSpec(task="a", planner="more")
+    assert execute_episode("tests.eval.fake_episodes:folder_writing_episode", spec, str(tmp_path)).error is None
+    moved = episode_file(old, tmp_path, "map.png")
+    assert moved is not None and moved.read_bytes() == b"old map" and "sensing-0.5m-30deg" in moved.parent.name
+    assert EpisodeRecord.model_validate_json((folder / "episode.json").read_text()).sensing == DEFAULT_SENSING
+    assert not (folder / "map.png").exists()
+    rerun = execute_episode("tests.eval.fake_episodes:folder_writing_episode", spec, str(tmp_path))
+    assert rerun.error is None and sorted(p.name for p in (tmp_path / "episodes").iterdir()) == sorted(
+        [folder.name, moved.parent.name]
+    )  # the same episode run again replaces its own files, nothing moves
 
 
 def test_a_bad_value_fails_first_and_a_resumed_run_must_keep_its_cadence(tmp_path: Path) -> None:

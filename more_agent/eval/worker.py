@@ -10,7 +10,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from more_agent.errors import UserError
-from more_agent.eval.store import episode_dir
+from more_agent.eval.episode_folder import EPISODE_FILE, read_record
+from more_agent.eval.store import episode_dir, of_spec
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import redact
 
@@ -46,6 +47,7 @@ def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRec
     out_dir = episode_dir(Path(run_dir), spec)
     start = time.perf_counter()
     try:
+        move_aside_other_episode(out_dir, spec)
         out_dir.mkdir(parents=True, exist_ok=True)
         record = resolve_episode_fn(fn_path)(spec, out_dir=out_dir)
         if not isinstance(record, EpisodeRecord):
@@ -54,3 +56,22 @@ def execute_episode(fn_path: str, spec: EpisodeSpec, run_dir: str) -> EpisodeRec
     except Exception as e:  # noqa: BLE001 - any episode failure is recorded, the run goes on
         rec = error_record(spec, f"{type(e).__name__}: {e}", traceback.format_exc())
         return rec.model_copy(update={"timings": {"total": time.perf_counter() - start}})
+
+
+def move_aside_other_episode(out_dir: Path, spec: EpisodeSpec) -> None:
+    """Before ``spec``'s episode clears ``out_dir``: when the folder holds a finished episode of other settings
+    (a run written before a setting was part of folder names, such as ``--sensing``, resumed with
+    ``--allow-mixed``), move it to the folder today's layout names for it, where the report looks first, so
+    that no result already written is lost. An unreadable record is left to be replaced, as before."""
+    try:
+        old = read_record(out_dir / EPISODE_FILE)
+    except (UserError, OSError):
+        return
+    if of_spec(old, spec):
+        return
+    own = episode_dir(out_dir.parents[1], old)
+    target, n = own, 0
+    while target.exists():
+        n += 1
+        target = own.with_name(f"{own.name}__earlier{n}")
+    out_dir.rename(target)

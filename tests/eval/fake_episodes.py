@@ -116,3 +116,15 @@ def remembering_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> Ep
             "failure_summaries": [f"{spec.task} s{spec.seed} trial {spec.trial} failed"],
         }
     )
+
+
+def folder_writing_episode(spec: EpisodeSpec, *, out_dir: Path | None = None) -> EpisodeRecord:
+    """``deterministic_episode`` that, as the real runner does, clears its folder and writes its ``episode.json``."""
+    from more_agent.eval.episode_folder import EpisodeFolder
+
+    record = deterministic_episode(spec, out_dir=out_dir)
+    if out_dir is not None:
+        folder = EpisodeFolder(out_dir)
+        folder.clear()
+        folder.write_record(record)
+    return record
