@@ -22,7 +22,8 @@ from more_agent.perception_spec import parse_perception
 from more_agent.sensing_spec import DEFAULT_SENSING, LEGACY_SENSING, parse_sensing
 
 RECORD_SCHEMA_VERSION = 6
-"""6: ``sensing`` (the sensing cadence); 5: ``perception`` (the perception mode), ``misperceived`` and ``perception_aliases``; 4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
+"""6: ``sensing`` (the sensing cadence); 5: ``perception`` (the perception mode), ``misperceived`` and
+``perception_aliases``; 4: typed action reasons, ``termination``, ``gave_up`` and ``error_kind`` (``error`` holds system errors
 only); 3: ``history`` (the action history option) and ``descriptions`` (the description mode). Older
 records are read through :data:`UPGRADES`."""
 

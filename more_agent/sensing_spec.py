@@ -8,8 +8,8 @@ fused one (``planners.policies.sensing.SensingSchedule`` applies the rule). Fram
 ``--sensing 1m/45deg``, the default, fuses a frame once the base has driven 1 m or turned 45 deg (below
 the 63.3 deg field of view of the Fetch's camera, so consecutive frames overlap; the Fetch drives at up
 to 1 m/s, so a mapper fusing once a second at full speed). Against a frame every 0.3 m and after every
-turn, its maps and graphs agree within the tolerance docs/benchmarks.md states ("the sensing cadence"),
-and the pipeline-ceiling SR is the same. ``--sensing 0.5m/30deg`` is the cadence of the versions before
+turn, its maps and graphs agree within the tolerance docs/sensors.md states ("Sensing cadence"), and
+the pipeline-ceiling SR is the same. ``--sensing 0.5m/30deg`` is the cadence of the versions before
 1m/45deg became the default (BUMBLE's rule for keeping frames). The canonical text
 (:meth:`SensingCadence.text`) is what records, run configurations, resume keys and folder names carry.
 """
@@ -69,6 +69,6 @@ def parse_sensing(text: str) -> SensingCadence:
         return SensingCadence(distance_m=float(match["distance"]), angle_deg=float(match["angle"]))
     except (ValueError, ValidationError):
         raise UserError(
-            f"--sensing {text!r}: the distance is above 0 m and the angle between 0 and {ROBOT.camera.hfov_deg:.1f} deg "
-            f"(the camera's field of view), {example}"
+            f"--sensing {text!r}: the distance is above 0 m and the angle between 0 and "
+            f"{ROBOT.camera.hfov_deg:.1f} deg (the camera's field of view), {example}"
         ) from None

@@ -62,18 +62,25 @@ def read_record(path: Path) -> EpisodeRecord:
     return parse_record(read_bounded(path, what="episode record"), source=str(path))
 
 
+def folder_record(path: Path) -> EpisodeRecord | None:
+    """The record of the finished episode in the folder ``path``; None when it holds none, or none that reads."""
+    record_path = Path(path) / EPISODE_FILE
+    if not record_path.is_file() or record_path.is_symlink():
+        return None
+    try:
+        return read_record(record_path)
+    except UserError:
+        return None
+
+
 def check_folder_for(path: Path, spec: EpisodeSpec) -> None:
     """Raise a UserError when the folder ``path`` holds a finished episode of another spec than ``spec``.
 
     An earlier run of the same episode, or an unfinished or unreadable one, is not refused: the
     episode runner clears its files (:meth:`EpisodeFolder.clear`) before writing the new ones.
     """
-    record_path = Path(path) / EPISODE_FILE
-    if not record_path.is_file() or record_path.is_symlink():
-        return
-    try:
-        old = read_record(record_path)
-    except UserError:
+    old = folder_record(path)
+    if old is None:
         return
     same = (old.task, old.seed, old.planner, old.llm, old.start) == (
         spec.task,

@@ -97,21 +97,16 @@ def _comparable(config: RunConfig) -> dict[str, object]:
 
 def _config_of_records(records: list[EpisodeRecord], config: RunConfig) -> RunConfig:
     """The run configuration ``records`` imply, for a folder whose ``run.json`` is missing."""
-    planners = sorted({r.planner for r in records})
     llms = sorted({str(r.llm) for r in records})
-    starts = sorted({r.start for r in records})
-    histories = sorted({r.history for r in records})
-    descriptions = sorted({r.descriptions for r in records})
-    perceptions = sorted({r.perception for r in records})
-    cadences = sorted({r.sensing for r in records})
+
+    def joined(name: str, sep: str = ",") -> str:
+        values = sorted({str(getattr(r, name)) for r in records})
+        return values[0] if len(values) == 1 else sep.join(values)
+
     return config.model_copy(
         update={
-            "start": starts[0] if len(starts) == 1 else ",".join(starts),
-            "history": histories[0] if len(histories) == 1 else ",".join(histories),
-            "descriptions": descriptions[0] if len(descriptions) == 1 else ",".join(descriptions),
-            "perception": perceptions[0] if len(perceptions) == 1 else ";".join(perceptions),
-            "sensing": cadences[0] if len(cadences) == 1 else ",".join(cadences),
-            "planner": planners[0] if len(planners) == 1 else ",".join(planners),
+            **{name: joined(name) for name in ("planner", "start", "history", "descriptions", "sensing")},
+            "perception": joined("perception", ";"),  # its text holds commas
             "llm": records[0].llm if len(llms) == 1 else ",".join(llms),
             "tasks": sorted({r.task for r in records} | set(config.tasks)),
             "seeds": sorted({r.seed for r in records} | set(config.seeds)),
@@ -287,18 +282,7 @@ def of_spec(record: EpisodeRecord, spec: EpisodeSpec, *, trial: bool = True) -> 
 
 def _match_key(x: EpisodeRecord | EpisodeSpec) -> tuple[object, ...]:
     """What a record shares with its spec beside scene, distractors and trial (:func:`of_spec`)."""
-    return (
-        x.task,
-        x.seed,
-        x.planner,
-        x.llm,
-        x.start,
-        x.descriptions,
-        x.history,
-        x.perception,
-        x.sensing,
-        x.long_term_memory,
-    )
+    return (x.task, x.seed, x.planner, *(getattr(x, name) for name in EPISODE_SETTINGS if name != "distractors"))
 
 
 def with_past_failures(spec: EpisodeSpec, records: list[EpisodeRecord]) -> EpisodeSpec | None:
@@ -348,8 +332,8 @@ def episode_dirname(
 
     The LLM, a start other than 'random', ``--no-distractors``, a description mode other than 'named' and
     a history other than 'paper', a perception other than 'gt', a sensing cadence other than the default and the
-    long-term memory are part of the name, so that the episodes of two settings mixed in one folder (``--allow-mixed``) never share, or clear, a
-    folder; so is a trial other than the first (``t1`` is the second).
+    long-term memory are part of the name, so that the episodes of two settings mixed in one folder
+    (``--allow-mixed``) never share, or clear, a folder; so is a trial other than the first (``t1`` is the second).
     """
     parts = [task, scene or "auto", f"s{seed}" + (f"t{trial}" if trial else ""), planner]
     if llm is not None:

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from more_agent.errors import UserError
-from more_agent.eval.episode_folder import EPISODE_FILE, read_record
+from more_agent.eval.episode_folder import folder_record
 from more_agent.eval.store import episode_dir, of_spec
 from more_agent.records import EpisodeRecord, EpisodeSpec
 from more_agent.redaction import redact
@@ -63,11 +63,8 @@ def move_aside_other_episode(out_dir: Path, spec: EpisodeSpec) -> None:
     (a run written before a setting was part of folder names, such as ``--sensing``, resumed with
     ``--allow-mixed``), move it to the folder today's layout names for it, where the report looks first, so
     that no result already written is lost. An unreadable record is left to be replaced, as before."""
-    try:
-        old = read_record(out_dir / EPISODE_FILE)
-    except (UserError, OSError):
-        return
-    if of_spec(old, spec):
+    old = folder_record(out_dir)
+    if old is None or of_spec(old, spec):
         return
     own = episode_dir(out_dir.parents[1], old)
     target, n = own, 0
