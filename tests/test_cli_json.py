@@ -63,6 +63,20 @@ def test_tasks_show_reads_the_world_run_drives_from_the_world_cache(
     assert text.exit_code == 0 and f"instantiated in {first['instance']['scene']} (seed 1; built in" in text.output
 
 
+def test_a_second_tasks_show_reads_what_it_shows_without_the_modules_that_build_or_unpickle_a_world(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The world cache keeps what ``tasks show`` shows beside the world: numba, scipy and bddl's goal
+    check (a second and a half) are not needed again."""
+    monkeypatch.setenv("MORE_AGENT_WORLD_CACHE", str(tmp_path / "worlds.sqlite"))
+    first = _imported(["tasks", "show", "buy_eggs", "--json"])
+    assert "more_agent.sim.instantiate" in first and "more_agent.sim.goals" in first
+    for args in (["tasks", "show", "buy_eggs", "--json"], ["tasks", "show", "buy_eggs", "--seed", "0"]):
+        second = _imported(args)
+        assert {m for m in second for slow in SLOW_IMPORTS if m == slow or m.startswith(slow + ".")} == set()
+        assert not {"more_agent.sim.instantiate", "more_agent.sim.goals", "more_agent.sim.world", "scipy"} & second
+
+
 def test_tasks_show_json_shows_a_goal_bddl_cannot_score() -> None:
     inst = _json(["tasks", "show", "make_a_bake_sale_stand_stall"])["instance"]  # no ground option for its goal
     assert inst["objects"] and inst["satisfiable"] is None

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -134,29 +134,27 @@ def _print_definition(definition: TaskDefinition) -> None:
 
 def _print_instance(task: str, scene: str | None, seed: int) -> None:
     """The task instantiated: its scene, description, whether any state meets its goal, and where each
-    scope's object is: the world ``run`` with that seed drives, read from the world cache when it holds it."""
-    from more_agent.sim.world_cache import instantiate_cached
-
-    inst = instantiate_cached(task, scene, seed)
+    scope's object is: the world ``run`` with that seed drives (:func:`_instance_summary`)."""
+    summary = _instance_summary(task, scene, seed)
+    inst = summary["instance"]
     console.print(
-        f"instantiated in {inst.scene} (seed {seed}; built in {inst.timings['total']:.2f} s)",
+        f"instantiated in {inst['scene']} (seed {seed}; built in {summary['built_s']:.2f} s)",
         highlight=False,
         markup=False,
     )
-    console.print(f"description: {inst.description}", highlight=False, markup=False)
-    if _satisfiable(inst) is False:
+    console.print(f"description: {inst['description']}", highlight=False, markup=False)
+    if inst["satisfiable"] is False:
         console.print(_UNSATISFIABLE, style="yellow", highlight=False, markup=False)
     table = Table(title="objects")
     for col in ("scope", "world object", "label", "category", "where"):
         table.add_column(col)
-    for s, name in inst.scope.items():
-        obj = inst.world.objects.get(name)
-        where = f"{obj.relation} {obj.parent}" if obj is not None and obj.parent else (obj.room or "") if obj else ""
-        table.add_row(*map(escape, (s, name, inst.label(s), obj.category if obj else "-", where)))
+    for o in inst["objects"]:
+        where = f"{o['relation']} {o['parent']}" if o["parent"] else o["room"] or ""
+        table.add_row(*map(escape, (o["scope"], o["object"], o["label"], o["category"] or "-", where)))
     console.print(table)
-    if inst.unsupported_literals:
+    if inst["unsupported_literals"]:
         console.print(
-            "init literals not modelled: " + ", ".join(inst.unsupported_literals), highlight=False, markup=False
+            "init literals not modelled: " + ", ".join(inst["unsupported_literals"]), highlight=False, markup=False
         )
 
 
@@ -174,40 +172,48 @@ def _show_json(task: str, scene: str | None, seed: int) -> dict[str, object]:
     scenes, drawn = suitable_scenes(task), draw_scenes(task, seed)
     if scene is not None:
         check_scene_suits(task, scene)
-    out: dict[str, object] = {
+    return {
         "task": task,
         "suitable_scenes": scenes,
         "episode_scenes": drawn,
         "seed": seed,
         "goal": [literal_text(lit) for lit in definition.goal],
-        "instance": None,
+        "instance": _instance_summary(task, scene, seed)["instance"] if scenes or scene is not None else None,
     }
-    if scenes or scene is not None:
-        from more_agent.sim.world_cache import instantiate_cached
 
-        inst = instantiate_cached(task, scene, seed)
-        objects = []
-        for s, name in inst.scope.items():
-            obj = inst.world.objects.get(name)
-            objects.append(
-                {
-                    "scope": s,
-                    "object": name,
-                    "label": inst.label(s),
-                    "category": obj.category if obj else None,
-                    "relation": obj.relation if obj else None,
-                    "parent": obj.parent if obj else None,
-                    "room": obj.room if obj else None,
-                }
-            )
-        out["instance"] = {
-            "scene": inst.scene,
-            "description": inst.description,
-            "objects": objects,
-            "unsupported_literals": list(inst.unsupported_literals),
-            "satisfiable": _satisfiable(inst),
-        }
-    return out
+
+def _instance_summary(task: str, scene: str | None, seed: int) -> dict[str, Any]:
+    """What ``tasks show`` shows of the instance ``run`` with that seed drives: ``instance`` (the ``--json``
+    keys) and ``built_s``. Kept in the world cache beside the world (``world_cache.summary_cached``), so a
+    second show neither unpickles the world nor checks its goal again."""
+    from more_agent.sim.world_cache import summary_cached
+
+    return summary_cached("tasks-show", task, scene, seed, _summarize)
+
+
+def _summarize(inst: TaskInstance) -> dict[str, Any]:
+    objects = []
+    for s, name in inst.scope.items():
+        obj = inst.world.objects.get(name)
+        objects.append(
+            {
+                "scope": s,
+                "object": name,
+                "label": inst.label(s),
+                "category": obj.category if obj else None,
+                "relation": obj.relation if obj else None,
+                "parent": obj.parent if obj else None,
+                "room": obj.room if obj else None,
+            }
+        )
+    instance = {
+        "scene": inst.scene,
+        "description": inst.description,
+        "objects": objects,
+        "unsupported_literals": list(inst.unsupported_literals),
+        "satisfiable": _satisfiable(inst),
+    }
+    return {"instance": instance, "built_s": inst.timings["total"]}
 
 
 def _satisfiable(inst: TaskInstance) -> bool | None:

@@ -12,6 +12,10 @@ Building a world is about a twentieth of a grounded episode and a third of an or
 a sweep of seven planners over 165 worlds builds each once. ``MORE_AGENT_WORLD_CACHE`` names the file
 (default ``~/.cache/more-agent/worlds.sqlite``), or ``off``. The cache never costs an episode: a file it
 cannot read or write, or a row it cannot load, is logged and the world is built as without it.
+
+Beside each world the cache keeps, as JSON, what a listing shows of it (:func:`summary_cached`): ``tasks show``
+reads that without unpickling the world, whose modules import numba and scipy (a second), or checking its
+goal again.
 """
 
 from __future__ import annotations
@@ -23,11 +27,12 @@ import os
 import pickle
 import sqlite3
 import sys
+from collections.abc import Callable
 from contextlib import closing
 from functools import cache, partial
 from importlib.metadata import version
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar
 
 if TYPE_CHECKING:
     from more_agent.sim.instantiate import TaskInstance
@@ -91,11 +96,38 @@ def instantiate_cached(
         key = instance_key(*build.args, **build.keywords)
     except OSError:  # an unreadable scene file: instantiate says what is wrong with it
         return build()
-    instance = _read(path, key)
+    instance = _read(path, "worlds", key, _unpickle_instance)
     if instance is None:
         instance = build()
-        _write(path, key, instance)
+        _write(path, "worlds", key, lambda: pickle.dumps(instance, protocol=pickle.HIGHEST_PROTOCOL))
     return instance
+
+
+def summary_cached(
+    kind: str, task: str, scene: str | None, seed: int, summarize: Callable[[TaskInstance], dict[str, Any]]
+) -> dict[str, Any]:
+    """``summarize`` of the instance :func:`instantiate_cached` gives for these arguments (the other settings
+    at their defaults), read from the JSON the cache keeps under ``kind`` beside the world when it holds it."""
+
+    def build() -> dict[str, Any]:
+        return summarize(instantiate_cached(task, scene, seed, **_DEFAULTS))
+
+    path = world_cache_path()
+    if path is None:
+        return build()
+    try:
+        key = f"{kind}:{instance_key(task, scene, seed, **_DEFAULTS)}"
+    except OSError:  # an unreadable scene file: instantiate says what is wrong with it
+        return build()
+    summary = _read(path, "summaries", key, _json_object)
+    if summary is None:
+        summary = build()
+        _write(path, "summaries", key, partial(json.dumps, summary))
+    return summary
+
+
+_DEFAULTS: dict[str, Any] = {"start": "random", "distractors": True, "descriptions": "named"}
+"""The settings :func:`summary_cached` instantiates with: ``instantiate_cached``'s defaults."""
 
 
 def _connect(path: Path) -> sqlite3.Connection:
@@ -103,30 +135,48 @@ def _connect(path: Path) -> sqlite3.Connection:
     connection.execute(
         "CREATE TABLE IF NOT EXISTS worlds (key TEXT PRIMARY KEY, fingerprint TEXT NOT NULL, instance BLOB NOT NULL)"
     )
+    connection.execute(
+        "CREATE TABLE IF NOT EXISTS summaries (key TEXT PRIMARY KEY, fingerprint TEXT NOT NULL, summary TEXT NOT NULL)"
+    )
     return connection
 
 
-def _read(path: Path, key: str) -> TaskInstance | None:
+def _unpickle_instance(blob: bytes) -> TaskInstance | None:
     from more_agent.sim.instantiate import TaskInstance
 
+    instance = pickle.loads(blob)
+    return instance if isinstance(instance, TaskInstance) else None
+
+
+def _json_object(text: str) -> dict[str, Any] | None:
+    value = json.loads(text)
+    return value if isinstance(value, dict) else None
+
+
+_T = TypeVar("_T")
+
+
+def _read(path: Path, table: str, key: str, load: Callable[[Any], _T | None]) -> _T | None:
+    """The row ``key`` of ``table`` (``worlds`` or ``summaries``) as ``load`` reads it; None when absent or unreadable."""
     if not path.is_file():
         return None
     try:
         with closing(_connect(path)) as connection:
-            row = connection.execute("SELECT instance FROM worlds WHERE key = ?", (key,)).fetchone()
-        instance = pickle.loads(row[0]) if row is not None else None
+            row = connection.execute(f"SELECT * FROM {table} WHERE key = ?", (key,)).fetchone()
+        return load(row[2]) if row is not None else None
     except Exception as e:  # noqa: BLE001 - a cache that fails is a cache miss, never a lost episode
         log.warning("world cache %s unreadable, building the world: %s: %s", path, type(e).__name__, e)
         return None
-    return instance if isinstance(instance, TaskInstance) else None
 
 
-def _write(path: Path, key: str, instance: TaskInstance) -> None:
+def _write(path: Path, table: str, key: str, dump: Callable[[], bytes | str]) -> None:
+    """Writes ``dump()`` as the row ``key`` of ``table``, dropping every row another code fingerprint wrote."""
     try:
-        blob = pickle.dumps(instance, protocol=pickle.HIGHEST_PROTOCOL)
+        value = dump()
         path.parent.mkdir(parents=True, exist_ok=True)
         with closing(_connect(path)) as connection:
-            connection.execute("DELETE FROM worlds WHERE fingerprint != ?", (code_fingerprint(),))
-            connection.execute("INSERT OR REPLACE INTO worlds VALUES (?, ?, ?)", (key, code_fingerprint(), blob))
+            for stale in ("worlds", "summaries"):
+                connection.execute(f"DELETE FROM {stale} WHERE fingerprint != ?", (code_fingerprint(),))
+            connection.execute(f"INSERT OR REPLACE INTO {table} VALUES (?, ?, ?)", (key, code_fingerprint(), value))
     except Exception as e:  # noqa: BLE001 - the episode goes on with the world it built
         log.warning("world cache %s not written: %s: %s", path, type(e).__name__, e)

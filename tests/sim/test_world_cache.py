@@ -14,7 +14,7 @@ from more_agent.eval.episode import run_episode
 from more_agent.records import EpisodeSpec
 from more_agent.sim import world_cache
 from more_agent.sim.instantiate import TaskInstance
-from more_agent.sim.world_cache import ENV_WORLD_CACHE, instantiate_cached, world_cache_path
+from more_agent.sim.world_cache import ENV_WORLD_CACHE, instantiate_cached, summary_cached, world_cache_path
 
 KITCHEN = Path(__file__).parents[1] / "fixtures" / "tasks_kitchen_scene.json"
 TASK = "putting_shopping_away"
@@ -54,9 +54,9 @@ def _signature(instance: TaskInstance) -> tuple:
     return objects, robot, instance.description, instance.scope, labels, instance.distractors, instance.start
 
 
-def _rows(path: Path) -> list[tuple[str, str]]:
+def _rows(path: Path, table: str = "worlds") -> list[tuple[str, str]]:
     with sqlite3.connect(path) as connection:
-        return connection.execute("SELECT key, fingerprint FROM worlds").fetchall()
+        return connection.execute(f"SELECT key, fingerprint FROM {table}").fetchall()
 
 
 def test_a_world_read_back_is_the_world_built_and_is_built_once_per_input(cache_file: Path, builds: list) -> None:
@@ -85,6 +85,30 @@ def test_other_code_builds_anew_and_its_worlds_replace_the_old(
     instantiate_cached(TASK, str(KITCHEN), 0)
     assert len(builds) == 2
     assert [fingerprint for _, fingerprint in _rows(cache_file)] == ["other code"]
+
+
+def test_a_summary_is_made_once_from_the_world_cached_and_again_for_other_kinds_rows_or_code(
+    cache_file: Path, builds: list, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    world = instantiate_cached(TASK, str(KITCHEN), 0)
+    seen: list[tuple] = []
+
+    def summarize(instance: TaskInstance) -> dict[str, object]:
+        seen.append(_signature(instance))
+        return {"description": instance.description, "scope": instance.scope}
+
+    first = summary_cached("test", TASK, str(KITCHEN), 0, summarize)
+    assert summary_cached("test", TASK, str(KITCHEN), 0, summarize) == first
+    assert first["description"] == world.description and seen == [_signature(world)] and len(builds) == 1
+    summary_cached("another", TASK, str(KITCHEN), 0, summarize)
+    summary_cached("test", TASK, str(KITCHEN), 1, summarize)
+    assert len(seen) == 3 and len(builds) == 2  # another kind is made again; another seed builds its world
+    with sqlite3.connect(cache_file) as connection:
+        connection.execute("UPDATE summaries SET summary = 'not json'")
+    assert summary_cached("test", TASK, str(KITCHEN), 0, summarize) == first and len(seen) == 4
+    monkeypatch.setattr(world_cache, "code_fingerprint", lambda: "other code")
+    assert summary_cached("test", TASK, str(KITCHEN), 0, summarize) == first and len(seen) == 5 and len(builds) == 3
+    assert {fingerprint for _, fingerprint in _rows(cache_file, "summaries") + _rows(cache_file)} == {"other code"}
 
 
 def test_a_scene_file_that_changed_builds_anew(cache_file: Path, builds: list, tmp_path: Path) -> None:
