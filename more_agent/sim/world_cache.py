@@ -127,7 +127,8 @@ def summary_cached(
 
 
 _DEFAULTS: dict[str, Any] = {"start": "random", "distractors": True, "descriptions": "named"}
-"""The settings :func:`summary_cached` instantiates with: ``instantiate_cached``'s defaults."""
+"""The settings :func:`summary_cached` instantiates with: ``instantiate_cached``'s defaults, the ones ``run``
+drives (tests/sim/test_world_cache.py: a summary is made from the world ``instantiate_cached`` built)."""
 
 
 def _connect(path: Path) -> sqlite3.Connection:
