@@ -15,7 +15,7 @@ from __future__ import annotations
 from enum import Enum
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from more_agent.errors import UserError
 from more_agent.perception_spec import parse_perception
@@ -89,22 +89,6 @@ LEGACY_HISTORY: HistoryMode = "lasting"
 
 GT_PERCEPTION = "gt"
 """The perception mode of the paper and of every version before the option: ground truth."""
-
-
-def canonical_perception(text: str) -> str:
-    """The canonical text of a perception mode (``more_agent.perception_spec``); ValueError when invalid."""
-    try:
-        return parse_perception(text).text()
-    except UserError as e:
-        raise ValueError(str(e)) from None
-
-
-def canonical_sensing(text: str) -> str:
-    """The canonical text of a sensing cadence (``more_agent.sensing_spec``); ValueError when invalid."""
-    try:
-        return parse_sensing(text).text()
-    except UserError as e:
-        raise ValueError(str(e)) from None
 
 
 LEGACY_DESCRIPTIONS = "paper"
@@ -412,12 +396,11 @@ class EpisodeSpec(FrozenModel):
         "(filled by the harness from their records, or by `run --bumble-memory` from its file).",
     )
 
-    @field_validator("perception")
+    @field_validator("perception", "sensing")
     @classmethod
-    def _canonical_perception(cls, value: str) -> str:
-        return canonical_perception(value)
-
-    @field_validator("sensing")
-    @classmethod
-    def _canonical_sensing(cls, value: str) -> str:
-        return canonical_sensing(value)
+    def _canonical(cls, value: str, info: ValidationInfo) -> str:
+        """The canonical text of a perception mode or a sensing cadence (their parsers' ``text()``)."""
+        try:
+            return (parse_perception(value) if info.field_name == "perception" else parse_sensing(value)).text()
+        except UserError as e:
+            raise ValueError(str(e)) from None

@@ -21,6 +21,7 @@ goal again.
 from __future__ import annotations
 
 import hashlib
+import inspect
 import json
 import logging
 import os
@@ -108,15 +109,20 @@ def summary_cached(
 ) -> dict[str, Any]:
     """``summarize`` of the instance :func:`instantiate_cached` gives for these arguments (the other settings
     at their defaults), read from the JSON the cache keeps under ``kind`` beside the world when it holds it."""
+    defaults = {
+        name: p.default
+        for name, p in inspect.signature(instantiate_cached).parameters.items()
+        if p.kind is p.KEYWORD_ONLY  # start, distractors, descriptions: the ones run drives
+    }
 
     def build() -> dict[str, Any]:
-        return summarize(instantiate_cached(task, scene, seed, **_DEFAULTS))
+        return summarize(instantiate_cached(task, scene, seed, **defaults))
 
     path = world_cache_path()
     if path is None:
         return build()
     try:
-        key = f"{kind}:{instance_key(task, scene, seed, **_DEFAULTS)}"
+        key = f"{kind}:{instance_key(task, scene, seed, **defaults)}"
     except OSError:  # an unreadable scene file: instantiate says what is wrong with it
         return build()
     summary = _read(path, "summaries", key, _json_object)
@@ -124,11 +130,6 @@ def summary_cached(
         summary = build()
         _write(path, "summaries", key, partial(json.dumps, summary))
     return summary
-
-
-_DEFAULTS: dict[str, Any] = {"start": "random", "distractors": True, "descriptions": "named"}
-"""The settings :func:`summary_cached` instantiates with: ``instantiate_cached``'s defaults, the ones ``run``
-drives (tests/sim/test_world_cache.py: a summary is made from the world ``instantiate_cached`` built)."""
 
 
 def _connect(path: Path) -> sqlite3.Connection:
@@ -166,7 +167,7 @@ def _read(path: Path, table: str, key: str, load: Callable[[Any], _T | None]) ->
             row = connection.execute(f"SELECT * FROM {table} WHERE key = ?", (key,)).fetchone()
         return load(row[2]) if row is not None else None
     except Exception as e:  # noqa: BLE001 - a cache that fails is a cache miss, never a lost episode
-        log.warning("world cache %s unreadable, building the world: %s: %s", path, type(e).__name__, e)
+        log.warning("world cache %s unreadable, building anew: %s: %s", path, type(e).__name__, e)
         return None
 
 
